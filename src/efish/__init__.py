@@ -1,0 +1,13 @@
+"""efish: MARL-trained weakly electric fish collectives, reproduced."""
+
+from importlib.metadata import PackageNotFoundError, version
+
+try:
+    __version__ = version("efish")
+except PackageNotFoundError:  # running from a source tree without installation
+    __version__ = "0+unknown"
+
+from .physics.snapshot import Snapshot, SnapshotBatch  # noqa: E402
+from .sensing import sense, sense_batch  # noqa: E402
+
+__all__ = ["Snapshot", "SnapshotBatch", "__version__", "sense", "sense_batch"]

@@ -1,0 +1,23 @@
+"""Typed, validated configuration composed with Hydra."""
+
+from .compose import compose, config_dir, to_yaml
+from .schema import (
+    ConfigError,
+    EfishConfig,
+    PhysicsConfig,
+    SceneConfig,
+    SensorsConfig,
+    validate,
+)
+
+__all__ = [
+    "ConfigError",
+    "EfishConfig",
+    "PhysicsConfig",
+    "SceneConfig",
+    "SensorsConfig",
+    "compose",
+    "config_dir",
+    "to_yaml",
+    "validate",
+]

@@ -1,0 +1,101 @@
+"""Compose the Hydra config tree and validate it against the schemas.
+
+Uses Hydra's compose API only: no working-directory change, no timestamped
+output folders. Every failure becomes a :class:`ConfigError` whose message is
+one line naming the key.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from pathlib import Path
+from typing import Sequence
+
+from .schema import ConfigError, EfishConfig, validate
+
+_SCHEMA_REGISTERED = False
+
+
+def config_dir() -> Path:
+    """Where the YAML config tree lives.
+
+    ``$EFISH_CONFIG_DIR`` wins; then a copy shipped inside the package (wheel
+    installs); then the repository's ``config/`` (editable installs).
+    """
+    env = os.environ.get("EFISH_CONFIG_DIR")
+    candidates = [Path(env)] if env else []
+    here = Path(__file__).resolve()
+    candidates += [here.parent.parent / "_config", here.parents[3] / "config"]
+    for path in candidates:
+        if (path / "config.yaml").is_file():
+            return path
+    raise ConfigError(f"no config tree found (looked in {', '.join(map(str, candidates))}); set EFISH_CONFIG_DIR")
+
+
+def _register_schemas() -> None:
+    """Register the dataclass schema so that Hydra type-checks and rejects unknown keys."""
+    global _SCHEMA_REGISTERED
+    if _SCHEMA_REGISTERED:
+        return
+    from hydra.core.config_store import ConfigStore
+
+    ConfigStore.instance().store(name="efish_schema", node=EfishConfig)
+    _SCHEMA_REGISTERED = True
+
+
+def compose(overrides: Sequence[str] = ()) -> EfishConfig:
+    """Compose ``config/config.yaml`` with Hydra overrides into a validated :class:`EfishConfig`.
+
+    >>> cfg = compose(["physics.image_order=2"])
+    >>> cfg.physics.image_order
+    2
+    """
+    from hydra import compose as hydra_compose
+    from hydra import initialize_config_dir
+    from hydra.core.global_hydra import GlobalHydra
+    from omegaconf import OmegaConf
+
+    _register_schemas()
+    GlobalHydra.instance().clear()
+    try:
+        with initialize_config_dir(config_dir=str(config_dir()), version_base=None, job_name="efish"):
+            raw = hydra_compose(config_name="config", overrides=list(overrides))
+        cfg = OmegaConf.to_object(raw)
+    except ConfigError:
+        raise
+    except Exception as exc:  # Hydra and OmegaConf raise many types; all mean "bad config"
+        raise ConfigError(one_line_message(exc)) from None
+    finally:
+        GlobalHydra.instance().clear()
+    validate(cfg)
+    return cfg
+
+
+def one_line_message(exc: BaseException) -> str:
+    """Reduce a Hydra/OmegaConf error (often multi-line, often chained) to one line naming the key."""
+    text = str(exc)
+    chain = exc.__cause__ or exc.__context__
+    if chain is not None:
+        text += "\n" + str(chain)
+    key = re.search(r"full_key:\s*(\S+)", text)
+    missing = re.search(r"Key '([^']+)' (?:is not in struct|not in '?\w+'?)", text)
+    override = re.search(r"Could not override '([^']+)'", text)
+    append = re.search(r"Could not append to config\. An item is already at '([^']+)'", text)
+    name = (key or override or missing or append)
+    lines = [ln.strip() for ln in text.splitlines() if ln.strip()]
+    if "is not in struct" in text or "Key '" in text and "not in" in text:
+        return f"unknown config key '{name.group(1) if name else '?'}'"
+    if "Could not find" in text and "config" in text.lower():
+        return lines[0]
+    if name is not None:
+        detail = next((ln for ln in lines if "Value" in ln or "type" in ln.lower()), lines[0])
+        return f"bad value for '{name.group(1)}': {detail}"
+    return lines[0] if lines else type(exc).__name__
+
+
+def to_yaml(cfg: EfishConfig) -> str:
+    """The resolved config as YAML, for ``config.yaml`` beside every output."""
+    from omegaconf import OmegaConf
+
+    return OmegaConf.to_yaml(OmegaConf.structured(cfg))

@@ -1,0 +1,194 @@
+"""Typed config schemas: one dataclass per Hydra config group.
+
+YAML files under ``config/`` only set values; the fields, their meaning and
+their allowed ranges live here. Every field is declared with :func:`param`, so
+its one-line doc and its range sit next to it and :func:`validate` can check a
+whole tree and name the offending key.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from typing import Any
+
+
+class ConfigError(ValueError):
+    """A config value is unknown, mistyped or out of range (message is one line)."""
+
+
+def param(default: Any, doc: str, *, lo: float | None = None, hi: float | None = None,
+          choices: tuple | None = None) -> Any:
+    """Declare a config field with a one-line doc and an optional allowed range."""
+    meta = {"doc": doc, "lo": lo, "hi": hi, "choices": choices}
+    if isinstance(default, (list, dict)):
+        return field(default_factory=lambda: type(default)(default), metadata=meta)
+    return field(default=default, metadata=meta)
+
+
+def group(cls: type) -> Any:
+    """Declare a nested config group with its defaults."""
+    return field(default_factory=cls)
+
+
+# --------------------------------------------------------------------- physics
+@dataclass
+class PhysicsConfig:
+    """Field sources, walls and the accuracy knobs of the field computation (SPEC 2)."""
+
+    eps0: float = param(8.854e-12, "vacuum permittivity, F/m", lo=0.0)
+    eod_charge_c: float = param(1.11e-15, "EOD monopole charge q, C", lo=0.0)
+    eod_half_separation_cm: float = param(0.5, "EOD monopoles sit at +-this along the body axis, cm", lo=0.0, hi=1.0)
+    agent_radius_cm: float = param(1.0, "agent body radius (induction), cm", lo=0.0)
+    pellet_radius_cm: float = param(0.25, "pellet radius (induction), cm", lo=0.0)
+    agent_dipole_cm: float = param(1.11e-23, "agent intrinsic dipole along body +x, C*m")
+    pellet_dipole_cm: float = param(1.11e-24, "pellet intrinsic dipole along pellet +y, C*m")
+    susceptibility: float = param(-0.5, "chi of bodies in water (negative: insulator)", lo=-10.0, hi=10.0)
+    softening_m: float = param(1e-5, "eps in |d|^2 + eps^2, m", lo=0.0, hi=1e-2)
+    image_order: int = param(1, "wall image order: 0 none, 1 one mirror per wall, up to 3", lo=0, hi=3)
+    image_scale: float = param(0.95, "scale of every image per reflection", lo=0.0, hi=1.0)
+    emission: bool = param(True, "agents may emit EODs at all")
+    intrinsic: bool = param(True, "intrinsic (always-on) dipoles of agents and pellets exist")
+    induction: bool = param(True, "bodies are polarised by EOD fields (induced dipoles)")
+    tolerance: float = param(1e-9, "skip a source when a bound on its field is below tolerance * E_min; 0 = exact", lo=0.0, hi=1e3)
+    dtype: str = param("float64", "floating type of the field kernels", choices=("float64", "float32"))
+
+
+# --------------------------------------------------------------------- sensors
+@dataclass
+class MormyromastConfig:
+    """Active electroreceptors: distortions of EOD fields (SPEC 3.1)."""
+
+    enabled: bool = param(True, "compute and report this receptor class")
+    count: int = param(36, "number of sensors", lo=1, hi=1024)
+    chin_count: int = param(10, "sensors on the chin arc", lo=0, hi=1024)
+    chin_half_angle_deg: float = param(30.0, "chin arc spans +-this from the heading, degrees", lo=0.0, hi=180.0)
+    e_min: float = param(5e-8, "lower end of the log range, V/m", lo=0.0)
+    e_max: float = param(5e-2, "upper end of the log range, V/m", lo=0.0)
+    g_self: float = param(1.0, "gate on the own-EOD image part (0 or 1)", choices=(0.0, 1.0))
+    g_cons: float = param(1.0, "gate on the conspecific-EOD image part (0 or 1)", choices=(0.0, 1.0))
+    k_cons: float = param(100.0, "gain on the cons part when silent or g_self = 0", lo=0.0)
+    wall_distortion: bool = param(False, "add the own EOD's wall images to the self part")
+
+
+@dataclass
+class AmpullaryConfig:
+    """Passive electroreceptors: intrinsic fields of bodies (SPEC 3.2)."""
+
+    enabled: bool = param(True, "compute and report this receptor class")
+    count: int = param(24, "number of sensors, evenly spaced from the heading", lo=1, hi=1024)
+    e_min: float = param(2e-10, "lower end of the log range, V/m", lo=0.0)
+    e_max: float = param(2e-8, "upper end of the log range, V/m", lo=0.0)
+
+
+@dataclass
+class KnollenorganConfig:
+    """Conspecific-EOD receptors, binarised per slot (SPEC 3.3)."""
+
+    enabled: bool = param(True, "compute and report this receptor class")
+    count: int = param(12, "sensors per conspecific slot, evenly spaced", lo=1, hi=1024)
+    threshold: float = param(2e-7, "|E.n| above this reads sign(E.n), V/m", lo=0.0)
+
+
+@dataclass
+class NoiseConfig:
+    """Multiplicative sensor noise (SPEC 3.4)."""
+
+    enabled: bool = param(True, "multiply raw readings by uniform noise")
+    low: float = param(0.95, "lower factor for every raw reading", lo=0.0)
+    high: float = param(1.05, "upper factor for every raw reading", lo=0.0)
+    interference_low: float = param(0.0, "lower ampullary factor while a conspecific emits", lo=0.0)
+    interference_high: float = param(2.0, "upper ampullary factor while a conspecific emits", lo=0.0)
+
+
+@dataclass
+class SensorsConfig:
+    """Receptor classes, their layout, ranges, gates and noise (SPEC 3)."""
+
+    sensor_radius_cm: float = param(1.0, "sensors sit on this circle around the body centre, cm", lo=0.0)
+    perception: str = param("electric", "electric fields or the ray-casting baseline", choices=("electric", "raycast"))
+    mormyromast: MormyromastConfig = group(MormyromastConfig)
+    ampullary: AmpullaryConfig = group(AmpullaryConfig)
+    knollenorgan: KnollenorganConfig = group(KnollenorganConfig)
+    noise: NoiseConfig = group(NoiseConfig)
+
+
+# ----------------------------------------------------------------------- scene
+@dataclass
+class SceneConfig:
+    """What a scene contains, as far as the effect plan needs to know."""
+
+    n_agents: int = param(4, "agents in the scene", lo=1, hi=64)
+    pellets: bool = param(True, "the scene has food pellets")
+    emitters: str = param("any", "which agents can emit: any, none (all muted)", choices=("any", "none"))
+
+
+# ----------------------------------------------------------------------- bench
+@dataclass
+class BenchConfig:
+    """Sizes of the physics benchmarks and the accuracy-vs-time study."""
+
+    scenes: int = param(64, "benchmark snapshots (4-agent 70x70 patchy)", lo=1)
+    repeats: int = param(3, "timing repeats; the fastest is reported", lo=1)
+    reference_scenes: int = param(8, "snapshots timed with the brute-force reference", lo=1)
+    tolerances: list = param([0.0, 1e-9, 1e-7, 1e-5, 1e-3, 1e-1, 1.0], "tolerances swept")
+    image_orders: list = param([0, 1, 2, 3], "wall image orders swept")
+    dtypes: list = param(["float64", "float32"], "kernel dtypes swept")
+    softenings_m: list = param([1e-5, 1e-4, 1e-3], "softening lengths swept, m")
+    seed: int = param(0, "seed of the benchmark scenes", lo=0)
+
+
+@dataclass
+class ScaleConfig:
+    """How big a run is: laptop, smoke or paper."""
+
+    name: str = param("laptop", "name of the scale, used in output paths")
+
+
+@dataclass
+class EfishConfig:
+    """The whole composed config."""
+
+    physics: PhysicsConfig = group(PhysicsConfig)
+    sensors: SensorsConfig = group(SensorsConfig)
+    scene: SceneConfig = group(SceneConfig)
+    bench: BenchConfig = group(BenchConfig)
+    scale: ScaleConfig = group(ScaleConfig)
+
+
+# ------------------------------------------------------------------ validation
+def validate(obj: Any, path: str = "") -> None:
+    """Check every field of a dataclass tree against its declared range or choices.
+
+    Raises :class:`ConfigError` with a one-line message naming the full key.
+    """
+    for f in dataclasses.fields(obj):
+        key = f"{path}{f.name}"
+        value = getattr(obj, f.name)
+        if dataclasses.is_dataclass(value):
+            validate(value, key + ".")
+            continue
+        meta = f.metadata
+        if meta.get("choices") is not None and value not in meta["choices"]:
+            allowed = ", ".join(str(c) for c in meta["choices"])
+            raise ConfigError(f"{key}={value!r} is not allowed: choose one of {allowed}")
+        lo, hi = meta.get("lo"), meta.get("hi")
+        if (lo is not None and value < lo) or (hi is not None and value > hi):
+            lo_s = "-inf" if lo is None else f"{lo:g}"
+            hi_s = "inf" if hi is None else f"{hi:g}"
+            raise ConfigError(f"{key}={value!r} is out of range: allowed [{lo_s}, {hi_s}]")
+    _check_consistency(obj, path)
+
+
+def _check_consistency(obj: Any, path: str) -> None:
+    """Cross-field rules that a single range cannot express."""
+    if isinstance(obj, (MormyromastConfig, AmpullaryConfig)) and not 0 < obj.e_min < obj.e_max:
+        raise ConfigError(f"{path}e_min={obj.e_min:g} must be > 0 and below {path}e_max={obj.e_max:g}")
+    if isinstance(obj, MormyromastConfig) and obj.chin_count > obj.count:
+        raise ConfigError(f"{path}chin_count={obj.chin_count} exceeds {path}count={obj.count}")
+    if isinstance(obj, NoiseConfig):
+        if obj.low > obj.high:
+            raise ConfigError(f"{path}low={obj.low:g} exceeds {path}high={obj.high:g}")
+        if obj.interference_low > obj.interference_high:
+            raise ConfigError(f"{path}interference_low exceeds {path}interference_high")
+

@@ -1,0 +1,64 @@
+"""Python side of the fast path: plan -> kernel constants, batch -> kernel arrays."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import kernels as kn
+from .plan import CM, EffectPlan
+from .reference import RawReadings, empty_readings
+from .snapshot import SnapshotBatch
+
+
+def kernel_constants(plan: EffectPlan) -> tuple[np.ndarray, np.ndarray]:
+    """The ``consts`` (working dtype) and ``flags`` (int64) arrays the kernels read."""
+    dtype = np.dtype(plan.dtype)
+    c = np.zeros(kn.N_CONSTS, dtype=np.float64)
+    c[kn.K], c[kn.Q], c[kn.HALF_SEP] = plan.k, plan.eod_charge, plan.eod_half_separation
+    c[kn.P_AGENT], c[kn.P_PELLET] = plan.agent_dipole, plan.pellet_dipole
+    c[kn.ALPHA_AGENT], c[kn.ALPHA_PELLET] = plan.alpha_agent, plan.alpha_pellet
+    c[kn.SOFT2], c[kn.R_SENS] = plan.softening2, plan.sensor_radius
+    c[kn.TOL_MORM] = plan.tolerance * plan.morm_range[0]
+    c[kn.TOL_AMP] = plan.tolerance * plan.amp_range[0]
+    # A whole array is exactly 0 after normalisation when its bound, times the noise, is <= E_min.
+    c[kn.ZERO_MORM] = plan.morm_range[0] / plan.max_noise
+    c[kn.ZERO_AMP] = plan.amp_range[0] / plan.max_amp_noise
+    c[kn.KNOLL_ZERO] = plan.knollen_threshold / plan.max_noise
+    c[kn.G_SELF], c[kn.G_CONS], c[kn.K_CONS] = plan.g_self, plan.g_cons, plan.k_cons
+    c[kn.ONE], c[kn.TWO], c[kn.THREE], c[kn.ZERO] = 1.0, 2.0, 3.0, 0.0
+    f = np.zeros(kn.N_FLAGS, dtype=np.int64)
+    f[kn.DO_MORM] = plan.on("mormyromast") and (plan.on("induction") or plan.on("wall_distortion"))
+    f[kn.DO_AMP] = plan.on("ampullary") and plan.on("intrinsic_fields")
+    f[kn.DO_KNOLL] = plan.on("knollenorgan")
+    f[kn.DO_INDUCTION] = plan.on("induction")
+    f[kn.DO_WALLDIST] = plan.on("wall_distortion")
+    f[kn.DO_PELLETS] = plan.on("pellets")
+    f[kn.CULL] = plan.tolerance > 0
+    return c.astype(dtype), f
+
+
+def fast_raw(batch: SnapshotBatch, plan: EffectPlan) -> RawReadings:
+    """Raw readings of every receptor of every agent with the numba kernels, in ``plan.dtype``."""
+    dtype = np.dtype(plan.dtype)
+    b, n, _ = batch.shape
+    out = empty_readings(b, n, plan, dtype)
+    if not plan.on("fields"):
+        return out
+    c, flags = kernel_constants(plan)
+    if not (flags[kn.DO_MORM] or flags[kn.DO_AMP] or flags[kn.DO_KNOLL]):
+        return out
+    emitting = np.ascontiguousarray(batch.agent_emitting & plan.on("eod_emission"))
+
+    def arr(x, scale=1.0):
+        return np.ascontiguousarray(np.asarray(x, dtype=np.float64) * scale, dtype=dtype)
+
+    def table(angles):
+        return arr(np.cos(angles)), arr(np.sin(angles))
+
+    kn.sense_batch_kernel(
+        arr(batch.agent_xy, CM), arr(batch.agent_heading), emitting,
+        arr(batch.pellet_xy, CM), arr(batch.pellet_orientation), np.ascontiguousarray(batch.pellet_alive),
+        arr(batch.width, CM), arr(batch.height, CM), plan.image_indices, arr(plan.image_weights), c, flags,
+        *table(plan.morm_angles), *table(plan.amp_angles), *table(plan.knollen_angles),
+        out.mormyromast, out.ampullary, out.knollenorgan)
+    return out

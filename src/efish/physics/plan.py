@@ -1,0 +1,174 @@
+"""The effect plan: simulate only what the scene calls for.
+
+A scene config says which effects exist; :func:`build_plan` turns the config
+into an :class:`EffectPlan` once per episode. Kernels for absent effects are
+not called at all, and every number the kernels need is derived here in SI
+units, so kernels never see a config. ``efish plan <overrides>`` prints
+:meth:`EffectPlan.explain`.
+
+Culling rule (``tolerance``): for each agent, a source (a body or one of its
+wall images) is skipped for a receptor class when a bound on its field at
+every sensor of that agent is below ``tolerance * E_min`` of the class. The
+bound for a dipole p at distance D from the agent centre, with sensors on a
+circle of radius r, is 2 k |p| / (D - r)^3, exact for the worst direction. A
+whole receptor array is skipped when the sum of the bounds of all its sources,
+times the largest noise factor, stays at or below E_min: every normalised
+reading is then exactly 0. ``tolerance = 0`` computes every source.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..config.schema import EfishConfig
+from ..sensors.layout import ampullary_angles, knollenorgan_angles, mormyromast_angles
+from .fields import coulomb_constant
+from .images import image_indices, image_weights
+
+CM = 0.01  # m per cm
+
+
+@dataclass(frozen=True)
+class Effect:
+    """One effect of the simulation: whether it runs and why."""
+
+    name: str
+    on: bool
+    why: str
+
+
+@dataclass(frozen=True)
+class EffectPlan:
+    """Which kernels run and every derived constant they need (SI units)."""
+
+    effects: tuple[Effect, ...]
+    dtype: str
+    tolerance: float
+    # sources
+    k: float                    # 1 / (4 pi eps0), V m / C
+    eod_charge: float           # C
+    eod_half_separation: float  # m
+    agent_dipole: float         # C m, body +x
+    pellet_dipole: float        # C m, pellet +y
+    alpha_agent: float          # induced moment per field, C m / (V/m)
+    alpha_pellet: float
+    softening2: float           # m^2
+    image_indices: np.ndarray   # int64[I, 2], identity first
+    image_weights: np.ndarray   # float64[I]
+    image_scale: float
+    # sensors
+    sensor_radius: float        # m
+    morm_angles: np.ndarray     # rad[36]
+    amp_angles: np.ndarray      # rad[24]
+    knollen_angles: np.ndarray  # rad[12]
+    morm_range: tuple[float, float]
+    amp_range: tuple[float, float]
+    knollen_threshold: float
+    g_self: float
+    g_cons: float
+    k_cons: float
+    noise: bool
+    noise_range: tuple[float, float]
+    interference_range: tuple[float, float]
+    notes: tuple[str, ...] = field(default=())
+
+    def on(self, name: str) -> bool:
+        """Whether the named effect runs."""
+        for e in self.effects:
+            if e.name == name:
+                return e.on
+        raise KeyError(f"no effect named {name!r}; effects are {[e.name for e in self.effects]}")
+
+    @property
+    def max_noise(self) -> float:
+        """Largest factor noise can multiply a Mormyromast or Knollenorgan reading by."""
+        return self.noise_range[1] if self.noise else 1.0
+
+    @property
+    def max_amp_noise(self) -> float:
+        """Largest factor noise can multiply an Ampullary reading by."""
+        return max(self.noise_range[1], self.interference_range[1]) if self.noise else 1.0
+
+    def explain(self) -> str:
+        """Human-readable table of effects and why each is in or out."""
+        width = max(len(e.name) for e in self.effects)
+        lines = [f"effect plan (dtype {self.dtype}, tolerance {self.tolerance:g}, "
+                 f"{len(self.image_weights) - 1} wall images per source)"]
+        lines += [f"  [{'x' if e.on else ' '}] {e.name:<{width}}  {e.why}" for e in self.effects]
+        lines += [f"  note: {n}" for n in self.notes]
+        return "\n".join(lines)
+
+
+def build_plan(cfg: EfishConfig, *, tolerance: float | None = None, dtype: str | None = None,
+               n_pellets: int | None = None, any_emitter: bool | None = None) -> EffectPlan:
+    """Decide which effects run for the scene in ``cfg`` and derive the kernel constants.
+
+    ``n_pellets`` and ``any_emitter`` refine the decision for a known episode
+    (no pellets -> no pellet loops; nobody can emit -> no induction).
+    """
+    ph, se, sc = cfg.physics, cfg.sensors, cfg.scene
+    tol = ph.tolerance if tolerance is None else float(tolerance)
+    if not tol >= 0:
+        raise ValueError(f"tolerance must be >= 0, got {tolerance}")
+    electric = se.perception == "electric"
+    pellets = sc.pellets and (n_pellets is None or n_pellets > 0)
+    emitters = ph.emission and sc.emitters != "none" and (any_emitter is None or any_emitter)
+    m_on, a_on, k_on = (electric and se.mormyromast.enabled, electric and se.ampullary.enabled,
+                        electric and se.knollenorgan.enabled)
+    gates_open = se.mormyromast.g_self > 0 or se.mormyromast.g_cons > 0
+    walls = ph.image_order > 0 and ph.image_scale > 0
+
+    def why_receptor(name: str, enabled: bool) -> str:
+        if not electric:
+            return "off: perception is ray casting, no fields are computed"
+        return "on" if enabled else f"off: sensors.{name}.enabled is false (ablated, reads 0)"
+
+    effects = (
+        Effect("fields", electric, "electric perception" if electric else "off: ray-casting baseline replaces all fields"),
+        Effect("mormyromast", m_on, why_receptor("mormyromast", se.mormyromast.enabled)),
+        Effect("ampullary", a_on, why_receptor("ampullary", se.ampullary.enabled)),
+        Effect("knollenorgan", k_on and emitters and sc.n_agents > 1,
+               "off: no conspecifics" if sc.n_agents < 2 else
+               ("off: nobody can emit, every spike is 0" if k_on and not emitters else why_receptor("knollenorgan", se.knollenorgan.enabled))),
+        Effect("eod_emission", emitters, "agents may emit" if emitters else "off: emission disabled or every agent muted"),
+        Effect("induction", m_on and emitters and ph.induction and gates_open,
+               "induced dipoles feed Mormyromasts" if m_on and emitters and ph.induction and gates_open else
+               "off: " + ("no Mormyromasts" if not m_on else "no emitters" if not emitters else
+                          "physics.induction is false" if not ph.induction else "both gates closed")),
+        Effect("self_part", m_on and se.mormyromast.g_self > 0, f"g_self = {se.mormyromast.g_self:g}"),
+        Effect("cons_part", m_on and se.mormyromast.g_cons > 0 and sc.n_agents > 1,
+               f"g_cons = {se.mormyromast.g_cons:g}" + ("" if sc.n_agents > 1 else ", but no conspecifics")),
+        Effect("wall_distortion", m_on and emitters and se.mormyromast.wall_distortion and walls,
+               "own EOD wall images added to the self part" if se.mormyromast.wall_distortion else "off: sensors.mormyromast.wall_distortion is false"),
+        Effect("intrinsic_fields", a_on and ph.intrinsic, "intrinsic dipoles feed Ampullary organs" if a_on and ph.intrinsic else
+               "off: " + ("no Ampullary organs" if not a_on else "physics.intrinsic is false")),
+        Effect("pellets", pellets, "pellet sources in the loops" if pellets else "off: the scene has no pellets"),
+        Effect("wall_images", electric and walls, f"image order {ph.image_order}, scale {ph.image_scale:g}" if walls else "off: image order 0 or scale 0"),
+        Effect("noise", electric and se.noise.enabled, "multiplicative, seeded" if se.noise.enabled else "off: sensors.noise.enabled is false"),
+        Effect("culling", electric and tol > 0, f"sources below {tol:g} x E_min skipped" if tol > 0 else "off: tolerance 0 computes every source"),
+    )
+    k = coulomb_constant(ph.eps0)
+    order = ph.image_order if walls else 0
+    idx = image_indices(order)
+    chi = ph.susceptibility
+    return EffectPlan(
+        effects=effects, dtype=dtype or ph.dtype, tolerance=tol,
+        k=k, eod_charge=ph.eod_charge_c, eod_half_separation=ph.eod_half_separation_cm * CM,
+        agent_dipole=ph.agent_dipole_cm, pellet_dipole=ph.pellet_dipole_cm,
+        alpha_agent=(ph.agent_radius_cm * CM) ** 3 * chi / k,
+        alpha_pellet=(ph.pellet_radius_cm * CM) ** 3 * chi / k,
+        softening2=ph.softening_m ** 2,
+        image_indices=idx, image_weights=image_weights(idx, ph.image_scale), image_scale=ph.image_scale,
+        sensor_radius=se.sensor_radius_cm * CM,
+        morm_angles=mormyromast_angles(se.mormyromast), amp_angles=ampullary_angles(se.ampullary),
+        knollen_angles=knollenorgan_angles(se.knollenorgan),
+        morm_range=(se.mormyromast.e_min, se.mormyromast.e_max),
+        amp_range=(se.ampullary.e_min, se.ampullary.e_max),
+        knollen_threshold=se.knollenorgan.threshold,
+        g_self=se.mormyromast.g_self, g_cons=se.mormyromast.g_cons, k_cons=se.mormyromast.k_cons,
+        noise=electric and se.noise.enabled,
+        noise_range=(se.noise.low, se.noise.high),
+        interference_range=(se.noise.interference_low, se.noise.interference_high),
+    )
