@@ -113,6 +113,25 @@ class SensorsConfig:
     noise: NoiseConfig = group(NoiseConfig)
 
 
+# ----------------------------------------------------------------------- arena
+@dataclass
+class ArenaConfig:
+    """Arena size and food layout (SPEC 8)."""
+
+    layout: str = param("patchy", "food layout", choices=("patchy", "uniform", "none"))
+    width_cm: float = param(70.0, "arena width, cm", lo=4.0, hi=10000.0)
+    height_cm: float = param(70.0, "arena height, cm", lo=4.0, hi=10000.0)
+    food_multiplier: float = param(1.0, "scales every food density (patch count for patchy)", lo=0.0, hi=100.0)
+    uniform_density: float = param(0.0045, "uniform: Poisson mean pellets per cm^2", lo=0.0)
+    uniform_cap_density: float = param(0.005, "uniform: at most round(this * area) pellets", lo=0.0)
+    patch_density: float = param(0.001, "patchy: ceil(this * area * multiplier) patches, at least 1", lo=0.0)
+    patch_radius_mean_cm: float = param(6.0, "patchy: patch radius mean, cm", lo=0.0)
+    patch_radius_sd_cm: float = param(1.5, "patchy: patch radius sd, cm", lo=0.0)
+    patch_pellet_density: float = param(0.15, "patchy: Poisson mean pellets per cm^2 of a patch", lo=0.0)
+    patch_cap_density: float = param(0.2, "patchy: at most round(this * pi r^2) pellets per patch", lo=0.0)
+    wall_margin_cm: float = param(1.0, "agents spawn at least this far from walls, cm", lo=0.0)
+
+
 # ----------------------------------------------------------------------- scene
 @dataclass
 class SceneConfig:
@@ -151,6 +170,7 @@ class EfishConfig:
 
     physics: PhysicsConfig = group(PhysicsConfig)
     sensors: SensorsConfig = group(SensorsConfig)
+    arena: ArenaConfig = group(ArenaConfig)
     scene: SceneConfig = group(SceneConfig)
     bench: BenchConfig = group(BenchConfig)
     scale: ScaleConfig = group(ScaleConfig)

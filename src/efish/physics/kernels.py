@@ -223,7 +223,7 @@ def sense_env(axy, heading, emitting, bx, by, bmx, bmy, alpha, img, c, flags,
                     my[j] *= c[K]
             thr = c[TOL_MORM] if flags[CULL] else -1.0
             count, total = gather_dipoles(axy[a, 0], axy[a, 1], bx, by, mx, my, -1, img, c, thr, cand)
-            walls = flags[DO_WALLDIST] and emitting[a] and img.shape[0] > 1
+            walls = flags[DO_WALLDIST] and emitting[a] and img.shape[0] > 1 and c[G_SELF] != c[ZERO]
             if walls or not flags[CULL] or total > c[ZERO_MORM]:
                 place_sensors(axy[a, 0], axy[a, 1], heading[a], cos_m, sin_m, c[R_SENS], sx[:sm], sy[:sm], nx[:sm], ny[:sm])
                 evaluate_candidates(out_m[a], cand, count, sx[:sm], sy[:sm], nx[:sm], ny[:sm], c)
@@ -242,14 +242,15 @@ def sense_env(axy, heading, emitting, bx, by, bmx, bmy, alpha, img, c, flags,
 
 @njit(cache=True, fastmath=_FASTMATH)
 def own_eod_images(out, xy, heading, img, c, sx, sy, nx, ny):
-    """The wall images (not the EOD itself) of an agent's own monopoles at its sensors."""
+    """The wall images (not the EOD itself) of an agent's own monopoles at its sensors, times g_self
+    (they are part of the self image, SPEC 3.1)."""
     ux = c[HALF_SEP] * np.cos(heading)
     uy = c[HALF_SEP] * np.sin(heading)
     for i in range(1, img.shape[0]):
         for sign in (c[ONE], -c[ONE]):
             px = img[i, 0] + img[i, 1] * (xy[0] + sign * ux)
             py = img[i, 2] + img[i, 3] * (xy[1] + sign * uy)
-            add_monopole(out, sx, sy, nx, ny, px, py, sign * c[K] * c[Q] * img[i, 4], c[SOFT2], c[ONE])
+            add_monopole(out, sx, sy, nx, ny, px, py, sign * c[G_SELF] * c[K] * c[Q] * img[i, 4], c[SOFT2], c[ONE])
 
 
 @njit(cache=True)

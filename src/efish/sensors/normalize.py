@@ -17,8 +17,11 @@ def log_normalize(s: np.ndarray, e_min: float, e_max: float) -> np.ndarray:
     if not 0 < e_min < e_max:
         raise ValueError(f"log_normalize needs 0 < e_min < e_max, got e_min={e_min}, e_max={e_max}")
     s = np.asarray(s)
-    m = np.clip(np.abs(s), e_min, e_max)
-    y = np.sign(s) * (np.log10(m) - np.log10(e_min)) / (np.log10(e_max) - np.log10(e_min))
+    # Normalise in float64 whatever the input: in float32, e_min itself rounds, and
+    # log10(m) - log10(e_min) would leave tiny non-zero values below the threshold.
+    s64 = s.astype(np.float64, copy=False)
+    m = np.clip(np.abs(s64), e_min, e_max)
+    y = np.sign(s64) * (np.log10(m) - np.log10(e_min)) / (np.log10(e_max) - np.log10(e_min))
     return y.astype(s.dtype if np.issubdtype(s.dtype, np.floating) else np.float64, copy=False)
 
 

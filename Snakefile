@@ -1,0 +1,16 @@
+# efish pipeline: run `snakemake --profile workflow/profiles/default` (laptop scale)
+# or add `--config scale=smoke|paper`. Rules call the `efish` CLI; all numbers
+# live in config/ and are read by efish, never repeated here.
+from snakemake.utils import min_version
+
+min_version("9.0")
+
+
+include: "workflow/rules/common.smk"
+include: "workflow/rules/bench.smk"
+
+
+rule all:
+    input:
+        all_targets(),
+    default_target: True

@@ -1,0 +1,1 @@
+"""Speed and accuracy studies printed by ``efish bench ...``."""

@@ -1,0 +1,125 @@
+"""``efish bench accuracy``: what accuracy costs in time.
+
+Sweeps the knobs of the field computation (culling tolerance x image order x
+dtype at the default softening, then softening at the defaults) and, for each
+setting, measures the time per agent-step of the fast path and the error of
+its normalised readings against a high-accuracy reference: float64, tolerance
+0, image order 3, default softening (``max_abs_error`` and the fractions), and
+against the exact result of the same model, i.e. the same image order and
+softening at float64 and tolerance 0 (``max_abs_error_same_model``: the error
+that culling and dtype alone cost). Writes one row per setting.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..config.schema import EfishConfig
+from ..physics.plan import build_plan
+from ..sensing import sense_batch
+from .physics import READING_KEYS
+from .scenes import benchmark_batch
+from .timing import best_time
+
+REFERENCE_IMAGE_ORDER = 3
+COLUMNS = ("tolerance", "image_order", "dtype", "softening_m", "is_default", "us_per_agent_step",
+           "agent_steps_per_s", "max_abs_error", "mean_abs_error", "sign_change_fraction",
+           "threshold_cross_fraction", "max_abs_error_same_model")
+
+
+def _with_physics(cfg: EfishConfig, **changes) -> EfishConfig:
+    return dataclasses.replace(cfg, physics=dataclasses.replace(cfg.physics, **changes))
+
+
+def compare_readings(approx: dict, exact: dict) -> dict:
+    """Error statistics of normalised readings over every receptor class.
+
+    ``sign_change_fraction``: readings whose sign differs where both are non-zero;
+    ``threshold_cross_fraction``: readings that are zero in one and non-zero in
+    the other (a detection gained or lost).
+    """
+    a = np.concatenate([np.asarray(approx[k], np.float64).ravel() for k in READING_KEYS])
+    e = np.concatenate([np.asarray(exact[k], np.float64).ravel() for k in READING_KEYS])
+    err = np.abs(a - e)
+    both = (a != 0) & (e != 0)
+    return {
+        "max_abs_error": float(err.max(initial=0.0)), "mean_abs_error": float(err.mean()) if err.size else 0.0,
+        "sign_change_fraction": float(np.mean(both & (np.sign(a) != np.sign(e)))),
+        "threshold_cross_fraction": float(np.mean((a == 0) != (e == 0))),
+    }
+
+
+def accuracy_settings(cfg: EfishConfig) -> list[dict]:
+    """The swept settings: tolerance x image order x dtype, then the softening sweep."""
+    bc, ph = cfg.bench, cfg.physics
+    grid = [dict(tolerance=float(t), image_order=int(o), dtype=str(d), softening_m=ph.softening_m)
+            for t in bc.tolerances for o in bc.image_orders for d in bc.dtypes]
+    grid += [dict(tolerance=ph.tolerance, image_order=ph.image_order, dtype=ph.dtype, softening_m=float(s))
+             for s in bc.softenings_m if s != ph.softening_m]
+    return grid
+
+
+def bench_accuracy(cfg: EfishConfig, progress=None) -> pd.DataFrame:
+    """Run the sweep on the benchmark scenes; one row per setting (see ``COLUMNS``)."""
+    bc, ph = cfg.bench, cfg.physics
+    batch = benchmark_batch(cfg, bc.scenes, bc.seed)
+    b, n, _ = batch.shape
+    ref_cfg = _with_physics(cfg, image_order=REFERENCE_IMAGE_ORDER, tolerance=0.0, dtype="float64")
+    exact = sense_batch(batch, build_plan(ref_cfg))
+    same_model: dict[tuple, dict] = {}  # exact readings per (image order, softening)
+    rows = []
+    settings = accuracy_settings(cfg)
+    for s in (progress(settings) if progress else settings):
+        plan = build_plan(_with_physics(cfg, **s))
+        seconds = best_time(lambda: sense_batch(batch, plan), bc.repeats)
+        model = (s["image_order"], s["softening_m"])
+        if model not in same_model:
+            exact_cfg = _with_physics(cfg, image_order=model[0], softening_m=model[1], tolerance=0.0, dtype="float64")
+            same_model[model] = sense_batch(batch, build_plan(exact_cfg))
+        approx = sense_batch(batch, plan)
+        rows.append({
+            **s, "is_default": (s["tolerance"] == ph.tolerance and s["image_order"] == ph.image_order
+                                and s["dtype"] == ph.dtype and s["softening_m"] == ph.softening_m),
+            "us_per_agent_step": 1e6 * seconds / (b * n), "agent_steps_per_s": b * n / seconds,
+            **compare_readings(approx, exact),
+            "max_abs_error_same_model": compare_readings(approx, same_model[model])["max_abs_error"]})
+    return pd.DataFrame(rows, columns=list(COLUMNS))
+
+
+def pareto_front(df: pd.DataFrame) -> np.ndarray:
+    """Boolean mask of settings not beaten in both time and max error by another setting."""
+    t, e = df["us_per_agent_step"].to_numpy(), df["max_abs_error"].to_numpy()
+    beaten = [(((t <= t[i]) & (e <= e[i])) & ((t < t[i]) | (e < e[i]))).any() for i in range(len(df))]
+    return ~np.array(beaten, dtype=bool)
+
+
+def plot_accuracy(df: pd.DataFrame, path: str | Path) -> None:
+    """Time per agent-step against max error; Pareto front joined, default ringed."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    floor = 1e-17  # exact agreement would vanish on a log axis
+    err = df["max_abs_error"].clip(lower=floor)
+    fig, ax = plt.subplots(figsize=(6.5, 4.5), constrained_layout=True)
+    markers = {"float64": "o", "float32": "s"}
+    for (dtype, order), g in df.groupby(["dtype", "image_order"]):
+        ax.scatter(g["us_per_agent_step"], err[g.index], marker=markers.get(dtype, "o"),
+                   label=f"{dtype}, image order {order}", alpha=0.8)
+    front = df[pareto_front(df)].sort_values("us_per_agent_step")
+    ax.plot(front["us_per_agent_step"], err[front.index], "k--", lw=1, label="Pareto front")
+    default = df[df["is_default"]]
+    ax.scatter(default["us_per_agent_step"], err[default.index], s=220, facecolors="none",
+               edgecolors="red", linewidths=2, label="default")
+    ax.axhline(1e-6, color="grey", lw=0.8, ls=":")
+    ax.set(xscale="log", yscale="log", xlabel="time per agent-step (us, one thread)",
+           ylabel=f"max |error| of normalised readings (floor {floor:g})",
+           title="What accuracy costs in time")
+    ax.legend(fontsize=7, ncol=2)
+    fig.savefig(path, dpi=150)
+    plt.close(fig)

@@ -1,0 +1,115 @@
+"""The ``efish`` command: compose the config, call one package function, report.
+
+    efish config [overrides]                  print the resolved config
+    efish plan [overrides]                    which effects run, and why
+    efish bench physics [overrides] [--json]  sensing throughput, fast vs reference
+    efish bench accuracy [overrides] --out D  accuracy-vs-time study -> table + figure
+
+Overrides are Hydra's ``key=value`` (``physics.image_order=2``) or group
+choices (``arena=patchy70``). Every error is one line on stderr, exit code 2,
+and nothing is written.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Sequence
+
+from .config import ConfigError, compose, to_yaml
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="efish", description=__doc__.split("\n\n")[0],
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = p.add_subparsers(dest="command", required=True)
+    c = sub.add_parser("config", help="print the resolved config")
+    c.add_argument("overrides", nargs="*")
+    pl = sub.add_parser("plan", help="print the effect plan of a scene")
+    pl.add_argument("overrides", nargs="*")
+    b = sub.add_parser("bench", help="speed and accuracy studies")
+    bsub = b.add_subparsers(dest="bench", required=True)
+    bp = bsub.add_parser("physics", help="sensing throughput: fast path vs reference, one thread")
+    bp.add_argument("overrides", nargs="*")
+    bp.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    bp.add_argument("--out", type=Path, help="also write bench_physics.json (+ config, provenance) here")
+    ba = bsub.add_parser("accuracy", help="accuracy-vs-time sweep: table and figure")
+    ba.add_argument("overrides", nargs="*")
+    ba.add_argument("--out", type=Path, default=Path("results/bench"), help="output folder (default results/bench)")
+    ba.add_argument("--json", action="store_true", help="print the table as JSON records")
+    return p
+
+
+def _progress(items: list, label: str):
+    """tqdm bar on a terminal, one plain line per item otherwise."""
+    if sys.stderr.isatty():
+        from tqdm import tqdm
+
+        return tqdm(items, desc=label, unit="setting")
+
+    def lines():
+        for i, item in enumerate(items, 1):
+            print(f"{label}: {i}/{len(items)} {item}", file=sys.stderr, flush=True)
+            yield item
+    return lines()
+
+
+def _bench_physics(args, cfg, started) -> None:
+    from .bench.physics import bench_physics, format_physics
+    from .io import write_run_metadata, write_text_atomic
+
+    result = bench_physics(cfg)
+    print(json.dumps(result, indent=2) if args.json else format_physics(result))
+    if args.out:
+        write_text_atomic(args.out / "bench_physics.json", json.dumps(result, indent=2) + "\n")
+        write_run_metadata(args.out, to_yaml(cfg), started)
+
+
+def _bench_accuracy(args, cfg, started) -> None:
+    from .bench.accuracy import bench_accuracy, plot_accuracy
+    from .io import atomic_path, write_run_metadata
+
+    df = bench_accuracy(cfg, progress=lambda s: _progress(s, "accuracy"))
+    args.out.mkdir(parents=True, exist_ok=True)
+    with atomic_path(args.out / "bench_accuracy.parquet") as tmp:
+        df.to_parquet(tmp, index=False)
+    for ext in ("png", "pdf"):
+        with atomic_path(args.out / f"bench_accuracy.{ext}") as tmp:
+            plot_accuracy(df, tmp)
+    write_run_metadata(args.out, to_yaml(cfg), started)
+    if args.json:
+        print(df.to_json(orient="records", indent=1))
+    else:
+        cols = ["tolerance", "image_order", "dtype", "softening_m", "us_per_agent_step", "max_abs_error",
+                "threshold_cross_fraction"]
+        print(df[cols].to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+        print(f"wrote {args.out}/bench_accuracy.parquet and bench_accuracy.png/.pdf")
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``efish`` console script."""
+    args = _parser().parse_args(argv)
+    started = datetime.now(timezone.utc)
+    try:
+        cfg = compose(args.overrides)
+        if args.command == "config":
+            print(to_yaml(cfg), end="")
+        elif args.command == "plan":
+            from .physics.plan import build_plan
+
+            print(build_plan(cfg).explain())
+        elif args.bench == "physics":
+            _bench_physics(args, cfg, started)
+        else:
+            _bench_accuracy(args, cfg, started)
+    except (ConfigError, ValueError, OSError) as exc:
+        print(f"efish: error: {exc}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,1 @@
+"""The world the agents live in: arenas, bodies, steps, tasks."""
