@@ -52,6 +52,8 @@ class PhysicsConfig:
     induction: bool = param(True, "bodies are polarised by EOD fields (induced dipoles)")
     tolerance: float = param(1e-9, "skip a source when a bound on its field is below tolerance * E_min; 0 = exact", lo=0.0, hi=1e3)
     dtype: str = param("float64", "floating type of the field kernels", choices=("float64", "float32"))
+    far_field_cm: float = param(10.0, "with culling on, sources beyond this are interpolated from far-field points; 0 = off", lo=0.0)
+    far_field_points: int = param(21, "far-field points on the sensor circle (odd)", lo=3, hi=63)
 
 
 # --------------------------------------------------------------------- sensors
@@ -202,6 +204,8 @@ def validate(obj: Any, path: str = "") -> None:
 
 def _check_consistency(obj: Any, path: str) -> None:
     """Cross-field rules that a single range cannot express."""
+    if isinstance(obj, PhysicsConfig) and obj.far_field_points % 2 == 0:
+        raise ConfigError(f"{path}far_field_points={obj.far_field_points} must be odd")
     if isinstance(obj, (MormyromastConfig, AmpullaryConfig)) and not 0 < obj.e_min < obj.e_max:
         raise ConfigError(f"{path}e_min={obj.e_min:g} must be > 0 and below {path}e_max={obj.e_max:g}")
     if isinstance(obj, MormyromastConfig) and obj.chin_count > obj.count:

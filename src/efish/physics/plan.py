@@ -13,7 +13,10 @@ bound for a dipole p at distance D from the agent centre, with sensors on a
 circle of radius r, is 2 k |p| / (D - r)^3, exact for the worst direction. A
 whole receptor array is skipped when the sum of the bounds of all its sources,
 times the largest noise factor, stays at or below E_min: every normalised
-reading is then exactly 0. ``tolerance = 0`` computes every source.
+reading is then exactly 0. With tolerance > 0, sources farther than
+``far_field_cm`` are evaluated at ``far_field_points`` points on the sensor
+circle and interpolated to the sensors (see :mod:`efish.physics.sense_kernel`).
+``tolerance = 0`` computes every source at every sensor.
 """
 
 from __future__ import annotations
@@ -23,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..config.schema import EfishConfig
-from ..sensors.layout import ampullary_angles, knollenorgan_angles, mormyromast_angles
+from ..sensors.layout import ampullary_angles, even_angles, knollenorgan_angles, mormyromast_angles
 from .fields import coulomb_constant
 from .images import image_indices, image_weights
 
@@ -63,6 +66,8 @@ class EffectPlan:
     morm_angles: np.ndarray     # rad[36]
     amp_angles: np.ndarray      # rad[24]
     knollen_angles: np.ndarray  # rad[12]
+    far_radius: float           # m; 0 = no far-field interpolation
+    far_angles: np.ndarray      # rad[Q], evenly spaced from the heading
     morm_range: tuple[float, float]
     amp_range: tuple[float, float]
     knollen_threshold: float
@@ -148,6 +153,9 @@ def build_plan(cfg: EfishConfig, *, tolerance: float | None = None, dtype: str |
         Effect("wall_images", electric and walls, f"image order {ph.image_order}, scale {ph.image_scale:g}" if walls else "off: image order 0 or scale 0"),
         Effect("noise", electric and se.noise.enabled, "multiplicative, seeded" if se.noise.enabled else "off: sensors.noise.enabled is false"),
         Effect("culling", electric and tol > 0, f"sources below {tol:g} x E_min skipped" if tol > 0 else "off: tolerance 0 computes every source"),
+        Effect("far_field", electric and tol > 0 and ph.far_field_cm > 0,
+               f"sources beyond {ph.far_field_cm:g} cm interpolated from {ph.far_field_points} points"
+               if tol > 0 and ph.far_field_cm > 0 else "off: " + ("tolerance 0" if tol == 0 else "physics.far_field_cm is 0")),
     )
     k = coulomb_constant(ph.eps0)
     order = ph.image_order if walls else 0
@@ -164,6 +172,8 @@ def build_plan(cfg: EfishConfig, *, tolerance: float | None = None, dtype: str |
         sensor_radius=se.sensor_radius_cm * CM,
         morm_angles=mormyromast_angles(se.mormyromast), amp_angles=ampullary_angles(se.ampullary),
         knollen_angles=knollenorgan_angles(se.knollenorgan),
+        far_radius=ph.far_field_cm * CM if tol > 0 else 0.0,
+        far_angles=even_angles(ph.far_field_points),
         morm_range=(se.mormyromast.e_min, se.mormyromast.e_max),
         amp_range=(se.ampullary.e_min, se.ampullary.e_max),
         knollen_threshold=se.knollenorgan.threshold,
@@ -172,3 +182,17 @@ def build_plan(cfg: EfishConfig, *, tolerance: float | None = None, dtype: str |
         noise_range=(se.noise.low, se.noise.high),
         interference_range=(se.noise.interference_low, se.noise.interference_high),
     )
+
+
+def trig_interpolation_matrix(targets: np.ndarray, q: int) -> np.ndarray:
+    """Weights W (T, q) with f(targets) ~= W @ f(2 pi k / q) for trigonometric polynomials of degree (q-1)/2.
+
+    The periodic sinc (Dirichlet kernel) for an odd number of equispaced points.
+    """
+    if q % 2 == 0:
+        raise ValueError(f"trigonometric interpolation needs an odd number of points, got {q}")
+    x = targets[:, None] - even_angles(q)[None, :]
+    half = np.sin(x / 2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        w = np.sin(q * x / 2) / (q * half)
+    return np.where(np.abs(half) < 1e-12, 1.0, w)

@@ -1,0 +1,253 @@
+"""Per-agent assembly of raw readings in numba: culling, near and far sources.
+
+For each agent the sources (every body and its wall images) are gathered once
+into one list with two moment columns, the combined Mormyromast moment and the
+intrinsic (Ampullary) moment, culled by the bound of :mod:`efish.physics.plan`.
+Near sources are evaluated at every sensor. With culling on (tolerance > 0),
+sources farther than the far-field radius are evaluated at a few points evenly
+spaced on the sensor circle and carried to the sensors by trigonometric
+interpolation: the reading of a distant source is a smooth periodic function
+of the angle whose Fourier modes decay like (r / D)^m, so a handful of points
+holds it to far below the tolerance (measured by ``efish bench accuracy``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from .kernels import (
+    _FASTMATH, ALPHA_AGENT, ALPHA_PELLET, CULL, DO_AMP, DO_INDUCTION, DO_KNOLL, DO_MORM, DO_PELLETS,
+    DO_WALLDIST, FAR2, G_CONS, G_SELF, HALF_SEP, K, K_CONS, KNOLL_ZERO, M1X, M1Y, M2X, M2Y, N_SRC, ONE,
+    P_AGENT, P_PELLET, Q, R_SENS, SOFT2, SX, SY, TOL_AMP, TOL_MORM, ZERO, ZERO_AMP, ZERO_MORM,
+    add_dipole, add_monopole, far_readings, image_table, induced_dipoles, place_sensors,
+)
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def image_bounds(ax, ay, bx, by, img, r, geo):
+    """Positions and unit-moment bounds 2 w / (D - r)^3 of every body image seen from (ax, ay).
+
+    Branch-free over bodies so it vectorises; row k = i * bodies + j of ``geo``
+    holds (x, y, bound). A source inside the sensor circle gets an infinite bound.
+    """
+    nb = bx.shape[0]
+    for i in range(img.shape[0]):
+        ox, sx, oy, sy, w = img[i, 0], img[i, 1], img[i, 2], img[i, 3], img[i, 4]
+        for j in range(nb):
+            x = ox + sx * bx[j]
+            y = oy + sy * by[j]
+            gap = max(np.sqrt((x - ax) * (x - ax) + (y - ay) * (y - ay)) - r, 1e-100)
+            geo[0, i * nb + j] = x
+            geo[1, i * nb + j] = y
+            geo[2, i * nb + j] = 2.0 * w / (gap * gap * gap)
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def gather_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, img, c, thr1, thr2, geo, src):
+    """Images of body moments whose bound at agent ``a`` reaches a threshold.
+
+    Column 1 (Mormyromast) and column 2 (Ampullary) are culled separately; a
+    culled column is stored as 0. The agent's own intrinsic dipole enters only
+    through its images. Near sources fill ``src`` from the front, far ones
+    (beyond the far-field radius) from the back. Returns (near count, far
+    count, bound sum 1, bound sum 2).
+    """
+    nb, cap = bx.shape[0], src.shape[1]
+    image_bounds(ax, ay, bx, by, img, c[R_SENS], geo)
+    far2 = c[FAR2]
+    n_near = n_far = 0
+    total1 = total2 = 0.0  # bounds steer decisions only: float64 whatever the dtype
+    for j in range(nb):
+        mag1 = np.sqrt(m1x[j] * m1x[j] + m1y[j] * m1y[j])
+        mag2 = np.sqrt(m2x[j] * m2x[j] + m2y[j] * m2y[j])
+        if mag1 == 0 and mag2 == 0:
+            continue
+        for i in range(img.shape[0]):
+            k = i * nb + j
+            b1 = mag1 * geo[2, k]
+            b2 = mag2 * geo[2, k] if not (j == a and i == 0) else 0.0
+            total1 += b1
+            total2 += b2
+            keep1, keep2 = mag1 > 0 and b1 >= thr1, b2 > 0 and b2 >= thr2
+            if not (keep1 or keep2):
+                continue
+            x, y = geo[0, k], geo[1, k]
+            if (x - ax) * (x - ax) + (y - ay) * (y - ay) >= far2:
+                n_far += 1
+                q = cap - n_far
+            else:
+                q = n_near
+                n_near += 1
+            w = img[i, 4]
+            src[SX, q], src[SY, q] = x, y
+            src[M1X, q] = img[i, 1] * w * m1x[j] if keep1 else c[ZERO]
+            src[M1Y, q] = img[i, 3] * w * m1y[j] if keep1 else c[ZERO]
+            src[M2X, q] = img[i, 1] * w * m2x[j] if keep2 else c[ZERO]
+            src[M2Y, q] = img[i, 3] * w * m2y[j] if keep2 else c[ZERO]
+    return n_near, n_far, total1, total2
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def mormyromast_moments(a, emitting, p_ind, c, mx, my):
+    """g_self * self + g_cons * gain * cons moment of every body for agent ``a`` (k folded in).
+
+    gain = k_cons when ``a`` is silent or g_self = 0 (SPEC 3.1); the agent's own
+    induced dipole is excluded (the body is the sensor).
+    """
+    gain = c[K_CONS] if (not emitting[a] or c[G_SELF] == 0) else c[ONE]
+    for j in range(mx.shape[0]):
+        mx[j] = my[j] = c[ZERO]
+        if j == a:
+            continue
+        for e in range(emitting.shape[0]):
+            if emitting[e]:
+                w = c[G_SELF] if e == a else c[G_CONS] * gain
+                mx[j] += w * p_ind[j, e, 0]
+                my[j] += w * p_ind[j, e, 1]
+        mx[j] *= c[K]
+        my[j] *= c[K]
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def own_eod_images(out, xy, heading, img, c, sx, sy, nx, ny):
+    """The wall images (not the EOD itself) of an agent's own monopoles at its sensors, times g_self
+    (they are part of the self image, SPEC 3.1)."""
+    ux = c[HALF_SEP] * np.cos(heading)
+    uy = c[HALF_SEP] * np.sin(heading)
+    for i in range(1, img.shape[0]):
+        for sign in (c[ONE], -c[ONE]):
+            px = img[i, 0] + img[i, 1] * (xy[0] + sign * ux)
+            py = img[i, 2] + img[i, 3] * (xy[1] + sign * uy)
+            add_monopole(out, sx, sy, nx, ny, px, py, sign * c[G_SELF] * c[K] * c[Q] * img[i, 4], c[SOFT2], c[ONE])
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def knollenorgan_env(axy, heading, emitting, cos_k, sin_k, c, flags, out):
+    """out[a, slot] = direct EOD field of the slot's conspecific at a's sensors, no images."""
+    n, s_count = axy.shape[0], cos_k.shape[0]
+    sx, sy = np.empty(s_count, c.dtype), np.empty(s_count, c.dtype)
+    nx, ny = np.empty(s_count, c.dtype), np.empty(s_count, c.dtype)
+    kq = c[K] * c[Q]
+    for a in range(n):
+        place_sensors(axy[a, 0], axy[a, 1], heading[a], cos_k, sin_k, c[R_SENS], sx, sy, nx, ny)
+        slot = -1
+        for j in range(n):
+            if j == a:
+                continue
+            slot += 1
+            if not emitting[j]:
+                continue
+            # Mean-value bound on the pair field: |E| <= 2 h * 2 k q / (D - r - h)^3.
+            gap = np.sqrt((axy[j, 0] - axy[a, 0]) ** 2 + (axy[j, 1] - axy[a, 1]) ** 2) - c[R_SENS] - c[HALF_SEP]
+            if flags[CULL] and gap > 0 and 4.0 * kq * c[HALF_SEP] / gap ** 3 <= c[KNOLL_ZERO]:
+                continue  # every spike would be 0 after binarisation
+            ux = c[HALF_SEP] * np.cos(heading[j])
+            uy = c[HALF_SEP] * np.sin(heading[j])
+            add_monopole(out[a, slot], sx, sy, nx, ny, axy[j, 0] + ux, axy[j, 1] + uy, kq, c[SOFT2], c[ONE])
+            add_monopole(out[a, slot], sx, sy, nx, ny, axy[j, 0] - ux, axy[j, 1] - uy, -kq, c[SOFT2], c[ONE])
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def add_sources(out, src, count, col_x, col_y, sx, sy, nx, ny, c):
+    """Add the dipoles of column (col_x, col_y) of ``src[:count]`` at every sensor."""
+    for i in range(count):
+        if src[col_x, i] != 0 or src[col_y, i] != 0:
+            add_dipole(out, sx, sy, nx, ny, src[SX, i], src[SY, i], src[col_x, i], src[col_y, i],
+                       c[SOFT2], c[ONE], c[ONE] + c[ONE] + c[ONE])
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def interpolate_add(out, matrix, values):
+    """out += matrix @ values (trigonometric interpolation from far-field points to sensors)."""
+    for s in range(out.shape[0]):
+        acc = values[0] * 0
+        for q in range(values.shape[0]):
+            acc += matrix[s, q] * values[q]
+        out[s] += acc
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def sense_agent(a, axy, heading, emitting, bx, by, m1x, m1y, m2x, m2y, img, c, flags, tables,
+                interp_m, interp_a, geo, src, scratch, out_m, out_a):
+    """Mormyromast and Ampullary raw readings of agent ``a``.
+
+    ``tables`` rows: cos/sin of Mormyromast, Ampullary and far-point angles
+    (rows 0-1, 2-3, 4-5; padded with the column count in ``scratch`` layout).
+    ``scratch`` rows 0-3: sensor x, y, nx, ny; rows 4-5: far readings.
+    """
+    sm, sa, nq = out_m.shape[0], out_a.shape[0], interp_m.shape[1]
+    ax, ay = axy[a, 0], axy[a, 1]
+    thr1 = c[TOL_MORM] if flags[CULL] else -1.0
+    thr2 = c[TOL_AMP] if flags[CULL] else -1.0
+    n_near, n_far, tot1, tot2 = gather_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, img, c, thr1, thr2, geo, src)
+    near, far = src[:, :n_near], src[:, src.shape[1] - n_far:]
+    walls = flags[DO_WALLDIST] and emitting[a] and img.shape[0] > 1 and c[G_SELF] != c[ZERO]
+    do_m = flags[DO_MORM] and (walls or not flags[CULL] or tot1 > c[ZERO_MORM])
+    do_a = flags[DO_AMP] and (not flags[CULL] or tot2 > c[ZERO_AMP])
+    sx, sy, nx, ny = scratch[0], scratch[1], scratch[2], scratch[3]
+    if do_m:
+        place_sensors(ax, ay, heading[a], tables[0, :sm], tables[1, :sm], c[R_SENS], sx[:sm], sy[:sm], nx[:sm], ny[:sm])
+        add_sources(out_m, near, n_near, M1X, M1Y, sx[:sm], sy[:sm], nx[:sm], ny[:sm], c)
+        if walls:
+            own_eod_images(out_m, axy[a], heading[a], img, c, sx[:sm], sy[:sm], nx[:sm], ny[:sm])
+    if do_a:
+        place_sensors(ax, ay, heading[a], tables[2, :sa], tables[3, :sa], c[R_SENS], sx[:sa], sy[:sa], nx[:sa], ny[:sa])
+        add_sources(out_a, near, n_near, M2X, M2Y, sx[:sa], sy[:sa], nx[:sa], ny[:sa], c)
+    if n_far > 0 and (do_m or do_a):
+        place_sensors(ax, ay, heading[a], tables[4, :nq], tables[5, :nq], c[R_SENS], sx[:nq], sy[:nq], nx[:nq], ny[:nq])
+        far_readings(far, n_far, sx[:nq], sy[:nq], nx[:nq], ny[:nq], c, scratch[4, :nq], scratch[5, :nq])
+        if do_m:
+            interpolate_add(out_m, interp_m, scratch[4, :nq])
+        if do_a:
+            interpolate_add(out_a, interp_a, scratch[5, :nq])
+
+
+@njit(cache=True, error_model="numpy")
+def sense_batch_kernel(agent_xy, heading, emitting, pellet_xy, pellet_phi, pellet_alive, width, height,
+                       img_idx, img_w, c, flags, tables, interp_m, interp_a, cos_k, sin_k,
+                       out_m, out_a, out_k):
+    """Raw readings for B arenas. Positions in m, in the dtype of ``c``; outputs zeroed by the caller.
+
+    Bodies are the agents (first N) then the live pellets of each arena.
+    """
+    b_count, n = agent_xy.shape[0], agent_xy.shape[1]
+    nb_max = n + (pellet_xy.shape[1] if flags[DO_PELLETS] else 0)
+    cap = nb_max * img_idx.shape[0]
+    src = np.empty((N_SRC, cap), c.dtype)
+    geo = np.empty((3, cap), np.float64)
+    scratch = np.empty((6, tables.shape[1]), c.dtype)
+    p_ind = np.zeros((nb_max, n, 2), c.dtype)
+    body = np.empty((7, nb_max), c.dtype)  # x, y, alpha, m1x, m1y, m2x, m2y
+    for b in range(b_count):
+        img = image_table(width[b], height[b], img_idx, img_w, c)
+        nb = 0
+        for j in range(n):
+            body[0, nb], body[1, nb], body[2, nb] = agent_xy[b, j, 0], agent_xy[b, j, 1], c[ALPHA_AGENT]
+            body[5, nb] = c[K] * c[P_AGENT] * np.cos(heading[b, j]) if flags[DO_AMP] else c[ZERO]
+            body[6, nb] = c[K] * c[P_AGENT] * np.sin(heading[b, j]) if flags[DO_AMP] else c[ZERO]
+            nb += 1
+        for j in range(nb_max - n):
+            if pellet_alive[b, j]:
+                body[0, nb], body[1, nb], body[2, nb] = pellet_xy[b, j, 0], pellet_xy[b, j, 1], c[ALPHA_PELLET]
+                body[5, nb] = -c[K] * c[P_PELLET] * np.sin(pellet_phi[b, j]) if flags[DO_AMP] else c[ZERO]
+                body[6, nb] = c[K] * c[P_PELLET] * np.cos(pellet_phi[b, j]) if flags[DO_AMP] else c[ZERO]
+                nb += 1
+        induction = False
+        if flags[DO_INDUCTION]:
+            for e in range(n):
+                induction = induction or emitting[b, e]
+        if induction:
+            p_ind[:nb] = c[ZERO]
+            induced_dipoles(agent_xy[b], heading[b], emitting[b], body[0, :nb], body[1, :nb], body[2, :nb], img, c, p_ind)
+        for a in range(n if (flags[DO_MORM] or flags[DO_AMP]) else 0):
+            if flags[DO_MORM] and induction:
+                mormyromast_moments(a, emitting[b], p_ind[:nb], c, body[3, :nb], body[4, :nb])
+            else:
+                body[3, :nb] = c[ZERO]
+                body[4, :nb] = c[ZERO]
+            sense_agent(a, agent_xy[b], heading[b], emitting[b], body[0, :nb], body[1, :nb], body[3, :nb],
+                        body[4, :nb], body[5, :nb], body[6, :nb], img, c, flags, tables, interp_m, interp_a,
+                        geo, src, scratch, out_m[b, a], out_a[b, a])
+        if flags[DO_KNOLL]:
+            knollenorgan_env(agent_xy[b], heading[b], emitting[b], cos_k, sin_k, c, flags, out_k[b])
