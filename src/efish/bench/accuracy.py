@@ -26,7 +26,7 @@ from .scenes import benchmark_batch
 from .timing import best_time
 
 REFERENCE_IMAGE_ORDER = 3
-COLUMNS = ("tolerance", "image_order", "dtype", "softening_m", "is_default", "us_per_agent_step",
+COLUMNS = ("tolerance", "image_order", "dtype", "softening_m", "far_field", "is_default", "us_per_agent_step",
            "agent_steps_per_s", "max_abs_error", "mean_abs_error", "sign_change_fraction",
            "threshold_cross_fraction", "max_abs_error_same_model")
 
@@ -54,13 +54,23 @@ def compare_readings(approx: dict, exact: dict) -> dict:
 
 
 def accuracy_settings(cfg: EfishConfig) -> list[dict]:
-    """The swept settings: tolerance x image order x dtype, then the softening sweep."""
+    """The swept settings: tolerance x image order x dtype, then softening, then the
+    default tolerance without far-field interpolation (what interpolation buys)."""
     bc, ph = cfg.bench, cfg.physics
-    grid = [dict(tolerance=float(t), image_order=int(o), dtype=str(d), softening_m=ph.softening_m)
+    base = dict(tolerance=ph.tolerance, image_order=ph.image_order, dtype=ph.dtype, softening_m=ph.softening_m,
+                far_field=True)
+    grid = [{**base, "tolerance": float(t), "image_order": int(o), "dtype": str(d)}
             for t in bc.tolerances for o in bc.image_orders for d in bc.dtypes]
-    grid += [dict(tolerance=ph.tolerance, image_order=ph.image_order, dtype=ph.dtype, softening_m=float(s))
-             for s in bc.softenings_m if s != ph.softening_m]
+    grid += [{**base, "softening_m": float(s)} for s in bc.softenings_m if s != ph.softening_m]
+    if ph.far_field_levels:
+        grid.append({**base, "far_field": False})
     return grid
+
+
+def _setting_config(cfg: EfishConfig, s: dict) -> EfishConfig:
+    levels = cfg.physics.far_field_levels if s["far_field"] else []
+    return _with_physics(cfg, tolerance=s["tolerance"], image_order=s["image_order"], dtype=s["dtype"],
+                         softening_m=s["softening_m"], far_field_levels=levels)
 
 
 def bench_accuracy(cfg: EfishConfig, progress=None) -> pd.DataFrame:
@@ -74,7 +84,7 @@ def bench_accuracy(cfg: EfishConfig, progress=None) -> pd.DataFrame:
     rows = []
     settings = accuracy_settings(cfg)
     for s in (progress(settings) if progress else settings):
-        plan = build_plan(_with_physics(cfg, **s))
+        plan = build_plan(_setting_config(cfg, s))
         seconds = best_time(lambda: sense_batch(batch, plan), bc.repeats)
         model = (s["image_order"], s["softening_m"])
         if model not in same_model:
@@ -83,7 +93,8 @@ def bench_accuracy(cfg: EfishConfig, progress=None) -> pd.DataFrame:
         approx = sense_batch(batch, plan)
         rows.append({
             **s, "is_default": (s["tolerance"] == ph.tolerance and s["image_order"] == ph.image_order
-                                and s["dtype"] == ph.dtype and s["softening_m"] == ph.softening_m),
+                                and s["dtype"] == ph.dtype and s["softening_m"] == ph.softening_m
+                                and s["far_field"]),
             "us_per_agent_step": 1e6 * seconds / (b * n), "agent_steps_per_s": b * n / seconds,
             **compare_readings(approx, exact),
             "max_abs_error_same_model": compare_readings(approx, same_model[model])["max_abs_error"]})

@@ -52,8 +52,9 @@ class PhysicsConfig:
     induction: bool = param(True, "bodies are polarised by EOD fields (induced dipoles)")
     tolerance: float = param(1e-9, "skip a source when a bound on its field is below tolerance * E_min; 0 = exact", lo=0.0, hi=1e3)
     dtype: str = param("float64", "floating type of the field kernels", choices=("float64", "float32"))
-    far_field_cm: float = param(10.0, "with culling on, sources beyond this are interpolated from far-field points; 0 = off", lo=0.0)
-    far_field_points: int = param(21, "far-field points on the sensor circle (odd)", lo=3, hi=63)
+    far_field_levels: list = param([3, 5, 7, 9, 13, 17, 21, 31], "point counts (odd) a distant source may be interpolated from; [] = off")
+    far_field_min_cm: float = param(3.0, "sources closer than this are always evaluated at every sensor, cm", lo=1.0)
+    far_field_safety: float = param(100.0, "C in the interpolation error model C * Q * B * (r/D)^((Q+1)/2)", lo=1.0)
 
 
 # --------------------------------------------------------------------- sensors
@@ -152,7 +153,7 @@ class BenchConfig:
     scenes: int = param(64, "benchmark snapshots (4-agent 70x70 patchy)", lo=1)
     repeats: int = param(3, "timing repeats; the fastest is reported", lo=1)
     reference_scenes: int = param(8, "snapshots timed with the brute-force reference", lo=1)
-    tolerances: list = param([0.0, 1e-9, 1e-7, 1e-5, 1e-3, 1e-1, 1.0], "tolerances swept")
+    tolerances: list = param([0.0, 1e-11, 1e-9, 1e-8, 1e-7, 1e-6, 1e-5, 1e-3, 1e-1, 1.0], "tolerances swept")
     image_orders: list = param([0, 1, 2, 3], "wall image orders swept")
     dtypes: list = param(["float64", "float32"], "kernel dtypes swept")
     softenings_m: list = param([1e-5, 1e-4, 1e-3], "softening lengths swept, m")
@@ -204,8 +205,8 @@ def validate(obj: Any, path: str = "") -> None:
 
 def _check_consistency(obj: Any, path: str) -> None:
     """Cross-field rules that a single range cannot express."""
-    if isinstance(obj, PhysicsConfig) and obj.far_field_points % 2 == 0:
-        raise ConfigError(f"{path}far_field_points={obj.far_field_points} must be odd")
+    if isinstance(obj, PhysicsConfig) and any(q % 2 == 0 or not 3 <= q <= 63 for q in obj.far_field_levels):
+        raise ConfigError(f"{path}far_field_levels={list(obj.far_field_levels)} must hold odd counts in [3, 63]")
     if isinstance(obj, (MormyromastConfig, AmpullaryConfig)) and not 0 < obj.e_min < obj.e_max:
         raise ConfigError(f"{path}e_min={obj.e_min:g} must be > 0 and below {path}e_max={obj.e_max:g}")
     if isinstance(obj, MormyromastConfig) and obj.chin_count > obj.count:

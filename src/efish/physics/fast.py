@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import kernels as kn
-from .plan import CM, EffectPlan, trig_interpolation_matrix
+from .plan import CM, EffectPlan
 from .sense_kernel import sense_batch_kernel
 from .reference import RawReadings, empty_readings
 from .snapshot import SnapshotBatch
@@ -27,7 +27,8 @@ def kernel_constants(plan: EffectPlan) -> tuple[np.ndarray, np.ndarray]:
     c[kn.KNOLL_ZERO] = plan.knollen_threshold / plan.max_noise
     c[kn.G_SELF], c[kn.G_CONS], c[kn.K_CONS] = plan.g_self, plan.g_cons, plan.k_cons
     c[kn.ONE], c[kn.TWO], c[kn.THREE], c[kn.ZERO] = 1.0, 2.0, 3.0, 0.0
-    c[kn.FAR2] = plan.far_radius ** 2 if plan.far_radius > 0 else np.inf
+    c[kn.FAR_MIN2] = plan.far_min ** 2 if plan.far_levels else np.inf
+    c[kn.FAR_SAFETY] = plan.far_safety
     f = np.zeros(kn.N_FLAGS, dtype=np.int64)
     f[kn.DO_MORM] = plan.on("mormyromast") and (plan.on("induction") or plan.on("wall_distortion"))
     f[kn.DO_AMP] = plan.on("ampullary") and plan.on("intrinsic_fields")
@@ -54,17 +55,16 @@ def fast_raw(batch: SnapshotBatch, plan: EffectPlan) -> RawReadings:
     def arr(x, scale=1.0):
         return np.ascontiguousarray(np.asarray(x, dtype=np.float64) * scale, dtype=dtype)
 
-    angles = (plan.morm_angles, plan.amp_angles, plan.far_angles)
-    tables = np.zeros((6, max(len(a) for a in angles)))
+    angles = (plan.morm_angles, plan.amp_angles)
+    tables = np.zeros((4, max(len(a) for a in angles)))
     for row, a in enumerate(angles):
         tables[2 * row, :len(a)], tables[2 * row + 1, :len(a)] = np.cos(a), np.sin(a)
-    q = len(plan.far_angles)
     sense_batch_kernel(
         arr(batch.agent_xy, CM), arr(batch.agent_heading), emitting,
         arr(batch.pellet_xy, CM), arr(batch.pellet_orientation), np.ascontiguousarray(batch.pellet_alive),
         arr(batch.width, CM), arr(batch.height, CM), plan.image_indices, arr(plan.image_weights), c, flags,
-        arr(tables), arr(trig_interpolation_matrix(plan.morm_angles, q)),
-        arr(trig_interpolation_matrix(plan.amp_angles, q)),
+        arr(tables), np.array(plan.far_levels, dtype=np.int64), arr(plan.far_tables),
+        arr(plan.morm_interp), arr(plan.amp_interp),
         arr(np.cos(plan.knollen_angles)), arr(np.sin(plan.knollen_angles)),
         out.mormyromast, out.ampullary, out.knollenorgan)
     return out

@@ -22,7 +22,7 @@ from numba import njit
 # Indices into the ``consts`` array (module-level ints are compile-time constants).
 K, Q, HALF_SEP, P_AGENT, P_PELLET, ALPHA_AGENT, ALPHA_PELLET, SOFT2, R_SENS = range(9)
 TOL_MORM, TOL_AMP, ZERO_MORM, ZERO_AMP, KNOLL_ZERO, G_SELF, G_CONS, K_CONS = range(9, 17)
-ONE, TWO, THREE, ZERO, FAR2, N_CONSTS = 17, 18, 19, 20, 21, 22
+ONE, TWO, THREE, ZERO, FAR_MIN2, FAR_SAFETY, N_CONSTS = 17, 18, 19, 20, 21, 22, 23
 # Indices into the ``flags`` array.
 DO_MORM, DO_AMP, DO_KNOLL, DO_INDUCTION, DO_WALLDIST, DO_PELLETS, CULL, N_FLAGS = range(8)
 # Columns of the source list built per agent: position, Mormyromast moment, Ampullary moment.
@@ -84,13 +84,16 @@ def image_table(width, height, idx, weights, c):
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
 def induced_dipoles(axy, heading, emitting, bx, by, alpha, img, c, p_ind):
-    """p_ind[body, e] = alpha_body * E_e(body) for every emitter e, own EOD excluded (SPEC 2.3).
+    """p_ind[e, 0/1, body] = alpha_body * E_e(body) for every emitter e, own EOD excluded (SPEC 2.3).
 
     E_e is the field of e's two monopoles and all their wall images. Bodies are
-    the innermost loop so the sums vectorise; ``p_ind`` must arrive zeroed.
+    the innermost, contiguous loop so the sums vectorise; silent agents' rows are zero.
     """
     kq, soft2, one = c[K] * c[Q], c[SOFT2], c[ONE]
     for e in range(axy.shape[0]):
+        px, py = p_ind[e, 0], p_ind[e, 1]
+        px[:] = c[ZERO]
+        py[:] = c[ZERO]
         if not emitting[e]:
             continue
         ux = c[HALF_SEP] * np.cos(heading[e])
@@ -104,11 +107,14 @@ def induced_dipoles(axy, heading, emitting, bx, by, alpha, img, c, p_ind):
                     dx = bx[j] - mx
                     dy = by[j] - my
                     inv_r2 = one / (dx * dx + dy * dy + soft2)
-                    f = kqw * alpha[j] * inv_r2 * np.sqrt(inv_r2)
-                    p_ind[j, e, 0] += f * dx
-                    p_ind[j, e, 1] += f * dy
-        p_ind[e, e, 0] = c[ZERO]  # a body is not polarised by its own EOD
-        p_ind[e, e, 1] = c[ZERO]
+                    f = kqw * inv_r2 * np.sqrt(inv_r2)
+                    px[j] += f * dx
+                    py[j] += f * dy
+        for j in range(bx.shape[0]):
+            px[j] *= alpha[j]
+            py[j] *= alpha[j]
+        px[e] = c[ZERO]  # a body is not polarised by its own EOD
+        py[e] = c[ZERO]
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")

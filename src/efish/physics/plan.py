@@ -13,9 +13,10 @@ bound for a dipole p at distance D from the agent centre, with sensors on a
 circle of radius r, is 2 k |p| / (D - r)^3, exact for the worst direction. A
 whole receptor array is skipped when the sum of the bounds of all its sources,
 times the largest noise factor, stays at or below E_min: every normalised
-reading is then exactly 0. With tolerance > 0, sources farther than
-``far_field_cm`` are evaluated at ``far_field_points`` points on the sensor
-circle and interpolated to the sensors (see :mod:`efish.physics.sense_kernel`).
+reading is then exactly 0. With tolerance > 0, a distant source is evaluated
+at Q points on the sensor circle and interpolated to the sensors, with the
+smallest Q of ``far_field_levels`` whose error bound C Q B (r/D)^((Q+1)/2) stays
+below the same ``tolerance * E_min`` (see :mod:`efish.physics.sense_kernel`).
 ``tolerance = 0`` computes every source at every sensor.
 """
 
@@ -66,8 +67,12 @@ class EffectPlan:
     morm_angles: np.ndarray     # rad[36]
     amp_angles: np.ndarray      # rad[24]
     knollen_angles: np.ndarray  # rad[12]
-    far_radius: float           # m; 0 = no far-field interpolation
-    far_angles: np.ndarray      # rad[Q], evenly spaced from the heading
+    far_levels: tuple[int, ...]  # point counts Q of the far-field levels; () = off
+    far_min: float              # m; closer sources are always exact
+    far_safety: float           # C of the error model C * Q * B * (r/D)^((Q+1)/2)
+    far_tables: np.ndarray      # [L, 2, Qmax] cos, sin of each level's point angles
+    morm_interp: np.ndarray     # [L, 36, Qmax] level points -> Mormyromast angles
+    amp_interp: np.ndarray      # [L, 24, Qmax] level points -> Ampullary angles
     morm_range: tuple[float, float]
     amp_range: tuple[float, float]
     knollen_threshold: float
@@ -153,9 +158,9 @@ def build_plan(cfg: EfishConfig, *, tolerance: float | None = None, dtype: str |
         Effect("wall_images", electric and walls, f"image order {ph.image_order}, scale {ph.image_scale:g}" if walls else "off: image order 0 or scale 0"),
         Effect("noise", electric and se.noise.enabled, "multiplicative, seeded" if se.noise.enabled else "off: sensors.noise.enabled is false"),
         Effect("culling", electric and tol > 0, f"sources below {tol:g} x E_min skipped" if tol > 0 else "off: tolerance 0 computes every source"),
-        Effect("far_field", electric and tol > 0 and ph.far_field_cm > 0,
-               f"sources beyond {ph.far_field_cm:g} cm interpolated from {ph.far_field_points} points"
-               if tol > 0 and ph.far_field_cm > 0 else "off: " + ("tolerance 0" if tol == 0 else "physics.far_field_cm is 0")),
+        Effect("far_field", electric and tol > 0 and len(ph.far_field_levels) > 0,
+               f"distant sources interpolated from {list(ph.far_field_levels)} points on the sensor circle"
+               if tol > 0 and ph.far_field_levels else "off: " + ("tolerance 0" if tol == 0 else "physics.far_field_levels is empty")),
     )
     k = coulomb_constant(ph.eps0)
     order = ph.image_order if walls else 0
@@ -172,8 +177,9 @@ def build_plan(cfg: EfishConfig, *, tolerance: float | None = None, dtype: str |
         sensor_radius=se.sensor_radius_cm * CM,
         morm_angles=mormyromast_angles(se.mormyromast), amp_angles=ampullary_angles(se.ampullary),
         knollen_angles=knollenorgan_angles(se.knollenorgan),
-        far_radius=ph.far_field_cm * CM if tol > 0 else 0.0,
-        far_angles=even_angles(ph.far_field_points),
+        far_min=ph.far_field_min_cm * CM, far_safety=ph.far_field_safety,
+        **far_field_tables(tuple(ph.far_field_levels) if tol > 0 else (),
+                           mormyromast_angles(se.mormyromast), ampullary_angles(se.ampullary)),
         morm_range=(se.mormyromast.e_min, se.mormyromast.e_max),
         amp_range=(se.ampullary.e_min, se.ampullary.e_max),
         knollen_threshold=se.knollenorgan.threshold,
@@ -196,3 +202,16 @@ def trig_interpolation_matrix(targets: np.ndarray, q: int) -> np.ndarray:
     with np.errstate(divide="ignore", invalid="ignore"):
         w = np.sin(q * x / 2) / (q * half)
     return np.where(np.abs(half) < 1e-12, 1.0, w)
+
+
+def far_field_tables(levels: tuple[int, ...], morm_angles: np.ndarray, amp_angles: np.ndarray) -> dict:
+    """Point angles (cos, sin) and interpolation matrices of every far-field level, zero-padded to Qmax."""
+    q_max = max(levels, default=1)
+    tables = np.zeros((len(levels), 2, q_max))
+    morm = np.zeros((len(levels), len(morm_angles), q_max))
+    amp = np.zeros((len(levels), len(amp_angles), q_max))
+    for i, q in enumerate(levels):
+        tables[i, 0, :q], tables[i, 1, :q] = np.cos(even_angles(q)), np.sin(even_angles(q))
+        morm[i, :, :q] = trig_interpolation_matrix(morm_angles, q)
+        amp[i, :, :q] = trig_interpolation_matrix(amp_angles, q)
+    return {"far_levels": tuple(levels), "far_tables": tables, "morm_interp": morm, "amp_interp": amp}

@@ -1,14 +1,18 @@
-"""Per-agent assembly of raw readings in numba: culling, near and far sources.
+"""Per-agent assembly of raw readings in numba: culling, exact and interpolated sources.
 
 For each agent the sources (every body and its wall images) are gathered once
-into one list with two moment columns, the combined Mormyromast moment and the
-intrinsic (Ampullary) moment, culled by the bound of :mod:`efish.physics.plan`.
-Near sources are evaluated at every sensor. With culling on (tolerance > 0),
-sources farther than the far-field radius are evaluated at a few points evenly
-spaced on the sensor circle and carried to the sensors by trigonometric
-interpolation: the reading of a distant source is a smooth periodic function
-of the angle whose Fourier modes decay like (r / D)^m, so a handful of points
-holds it to far below the tolerance (measured by ``efish bench accuracy``).
+with two moment columns, the combined Mormyromast moment and the intrinsic
+(Ampullary) moment, culled by the bound of :mod:`efish.physics.plan`.
+
+With culling on (tolerance > 0) a source at distance D is not evaluated at
+every sensor when that is not needed: the reading of a dipole on the sensor
+circle (radius r) is a smooth periodic function of the angle whose Fourier
+modes decay like (r / D)^m, so its values at Q evenly spaced points carry it
+to the sensors by trigonometric interpolation with an error below
+C Q B (r/D)^((Q+1)/2) (B the source's bound, C = ``far_field_safety``; the
+factor was measured, then padded). Each source goes to the level with the
+smallest Q whose error stays below tolerance * E_min (bucket 0: exact at
+every sensor). ``efish bench accuracy`` measures the result.
 """
 
 from __future__ import annotations
@@ -18,7 +22,7 @@ from numba import njit
 
 from .kernels import (
     _FASTMATH, ALPHA_AGENT, ALPHA_PELLET, CULL, DO_AMP, DO_INDUCTION, DO_KNOLL, DO_MORM, DO_PELLETS,
-    DO_WALLDIST, FAR2, G_CONS, G_SELF, HALF_SEP, K, K_CONS, KNOLL_ZERO, M1X, M1Y, M2X, M2Y, N_SRC, ONE,
+    DO_WALLDIST, FAR_MIN2, FAR_SAFETY, G_CONS, G_SELF, HALF_SEP, K, K_CONS, KNOLL_ZERO, M1X, M1Y, M2X, M2Y, N_SRC, ONE,
     P_AGENT, P_PELLET, Q, R_SENS, SOFT2, SX, SY, TOL_AMP, TOL_MORM, ZERO, ZERO_AMP, ZERO_MORM,
     add_dipole, add_monopole, far_readings, image_table, induced_dipoles, place_sensors,
 )
@@ -29,7 +33,7 @@ def image_bounds(ax, ay, bx, by, img, r, geo):
     """Positions and unit-moment bounds 2 w / (D - r)^3 of every body image seen from (ax, ay).
 
     Branch-free over bodies so it vectorises; row k = i * bodies + j of ``geo``
-    holds (x, y, bound). A source inside the sensor circle gets an infinite bound.
+    holds (x, y, bound, distance D). A source inside the sensor circle gets a huge bound.
     """
     nb = bx.shape[0]
     for i in range(img.shape[0]):
@@ -37,26 +41,43 @@ def image_bounds(ax, ay, bx, by, img, r, geo):
         for j in range(nb):
             x = ox + sx * bx[j]
             y = oy + sy * by[j]
-            gap = max(np.sqrt((x - ax) * (x - ax) + (y - ay) * (y - ay)) - r, 1e-100)
+            dist = np.sqrt((x - ax) * (x - ax) + (y - ay) * (y - ay))
+            gap = max(dist - r, 1e-100)
             geo[0, i * nb + j] = x
             geo[1, i * nb + j] = y
             geo[2, i * nb + j] = 2.0 * w / (gap * gap * gap)
+            geo[3, i * nb + j] = dist
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def gather_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, img, c, thr1, thr2, geo, src):
-    """Images of body moments whose bound at agent ``a`` reaches a threshold.
+def interpolation_level(dist, b1, b2, thr1, thr2, levels, c):
+    """Bucket of a source: the first level whose error bound is below both thresholds; 0 = exact."""
+    if dist * dist < c[FAR_MIN2]:
+        return 0
+    allowed = min(thr1 / b1 if b1 > 0 else np.inf, thr2 / b2 if b2 > 0 else np.inf)
+    x = c[R_SENS] / dist
+    power, order = 1.0, 0
+    for lv in range(levels.shape[0]):
+        while order < (levels[lv] + 1) // 2:
+            power *= x
+            order += 1
+        if c[FAR_SAFETY] * levels[lv] * power <= allowed:
+            return lv + 1
+    return 0
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def gather_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, img, c, thr1, thr2, levels, geo, src, counts):
+    """Images of body moments whose bound at agent ``a`` reaches a threshold, bucketed by level.
 
     Column 1 (Mormyromast) and column 2 (Ampullary) are culled separately; a
     culled column is stored as 0. The agent's own intrinsic dipole enters only
-    through its images. Near sources fill ``src`` from the front, far ones
-    (beyond the far-field radius) from the back. Returns (near count, far
-    count, bound sum 1, bound sum 2).
+    through its images. ``src[level, :, :counts[level]]`` receives the sources.
+    Returns the bound sums of both columns.
     """
-    nb, cap = bx.shape[0], src.shape[1]
+    nb = bx.shape[0]
     image_bounds(ax, ay, bx, by, img, c[R_SENS], geo)
-    far2 = c[FAR2]
-    n_near = n_far = 0
+    counts[:] = 0
     total1 = total2 = 0.0  # bounds steer decisions only: float64 whatever the dtype
     for j in range(nb):
         mag1 = np.sqrt(m1x[j] * m1x[j] + m1y[j] * m1y[j])
@@ -72,41 +93,34 @@ def gather_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, img, c, thr1, thr2, ge
             keep1, keep2 = mag1 > 0 and b1 >= thr1, b2 > 0 and b2 >= thr2
             if not (keep1 or keep2):
                 continue
-            x, y = geo[0, k], geo[1, k]
-            if (x - ax) * (x - ax) + (y - ay) * (y - ay) >= far2:
-                n_far += 1
-                q = cap - n_far
-            else:
-                q = n_near
-                n_near += 1
+            lv = interpolation_level(geo[3, k], b1 if keep1 else 0.0, b2 if keep2 else 0.0, thr1, thr2, levels, c)
+            q = counts[lv]
+            counts[lv] += 1
             w = img[i, 4]
-            src[SX, q], src[SY, q] = x, y
-            src[M1X, q] = img[i, 1] * w * m1x[j] if keep1 else c[ZERO]
-            src[M1Y, q] = img[i, 3] * w * m1y[j] if keep1 else c[ZERO]
-            src[M2X, q] = img[i, 1] * w * m2x[j] if keep2 else c[ZERO]
-            src[M2Y, q] = img[i, 3] * w * m2y[j] if keep2 else c[ZERO]
-    return n_near, n_far, total1, total2
+            src[lv, SX, q], src[lv, SY, q] = geo[0, k], geo[1, k]
+            src[lv, M1X, q] = img[i, 1] * w * m1x[j] if keep1 else c[ZERO]
+            src[lv, M1Y, q] = img[i, 3] * w * m1y[j] if keep1 else c[ZERO]
+            src[lv, M2X, q] = img[i, 1] * w * m2x[j] if keep2 else c[ZERO]
+            src[lv, M2Y, q] = img[i, 3] * w * m2y[j] if keep2 else c[ZERO]
+    return total1, total2
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def mormyromast_moments(a, emitting, p_ind, c, mx, my):
+def mormyromast_moments(a, emitting, p_ind, p_sum, c, mx, my):
     """g_self * self + g_cons * gain * cons moment of every body for agent ``a`` (k folded in).
 
-    gain = k_cons when ``a`` is silent or g_self = 0 (SPEC 3.1); the agent's own
+    self = p_ind[a] (zero when a is silent), cons = p_sum - p_ind[a]; gain =
+    k_cons when ``a`` is silent or g_self = 0 (SPEC 3.1). The agent's own
     induced dipole is excluded (the body is the sensor).
     """
     gain = c[K_CONS] if (not emitting[a] or c[G_SELF] == 0) else c[ONE]
+    w_cons = c[G_CONS] * gain * c[K]
+    w_self = c[G_SELF] * c[K] - w_cons
     for j in range(mx.shape[0]):
-        mx[j] = my[j] = c[ZERO]
-        if j == a:
-            continue
-        for e in range(emitting.shape[0]):
-            if emitting[e]:
-                w = c[G_SELF] if e == a else c[G_CONS] * gain
-                mx[j] += w * p_ind[j, e, 0]
-                my[j] += w * p_ind[j, e, 1]
-        mx[j] *= c[K]
-        my[j] *= c[K]
+        mx[j] = w_cons * p_sum[0, j] + w_self * p_ind[a, 0, j]
+        my[j] = w_cons * p_sum[1, j] + w_self * p_ind[a, 1, j]
+    mx[a] = c[ZERO]
+    my[a] = c[ZERO]
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
@@ -168,44 +182,46 @@ def interpolate_add(out, matrix, values):
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def sense_agent(a, axy, heading, emitting, bx, by, m1x, m1y, m2x, m2y, img, c, flags, tables,
-                interp_m, interp_a, geo, src, scratch, out_m, out_a):
+def sense_agent(a, axy, heading, emitting, bx, by, m1x, m1y, m2x, m2y, img, c, flags, tables, levels,
+                far_tables, interp_m, interp_a, geo, src, counts, scratch, out_m, out_a):
     """Mormyromast and Ampullary raw readings of agent ``a``.
 
-    ``tables`` rows: cos/sin of Mormyromast, Ampullary and far-point angles
-    (rows 0-1, 2-3, 4-5; padded with the column count in ``scratch`` layout).
-    ``scratch`` rows 0-3: sensor x, y, nx, ny; rows 4-5: far readings.
+    ``tables`` rows 0-1 / 2-3: cos, sin of Mormyromast / Ampullary angles.
+    ``scratch`` rows 0-3: sensor x, y, nx, ny; rows 4-5: readings at level points.
     """
-    sm, sa, nq = out_m.shape[0], out_a.shape[0], interp_m.shape[1]
+    sm, sa = out_m.shape[0], out_a.shape[0]
     ax, ay = axy[a, 0], axy[a, 1]
     thr1 = c[TOL_MORM] if flags[CULL] else -1.0
     thr2 = c[TOL_AMP] if flags[CULL] else -1.0
-    n_near, n_far, tot1, tot2 = gather_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, img, c, thr1, thr2, geo, src)
-    near, far = src[:, :n_near], src[:, src.shape[1] - n_far:]
-    walls = flags[DO_WALLDIST] and emitting[a] and img.shape[0] > 1 and c[G_SELF] != c[ZERO]
+    tot1, tot2 = gather_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, img, c, thr1, thr2, levels, geo, src, counts)
+    walls = flags[DO_WALLDIST] and emitting[a] and img.shape[0] > 1
     do_m = flags[DO_MORM] and (walls or not flags[CULL] or tot1 > c[ZERO_MORM])
     do_a = flags[DO_AMP] and (not flags[CULL] or tot2 > c[ZERO_AMP])
     sx, sy, nx, ny = scratch[0], scratch[1], scratch[2], scratch[3]
     if do_m:
         place_sensors(ax, ay, heading[a], tables[0, :sm], tables[1, :sm], c[R_SENS], sx[:sm], sy[:sm], nx[:sm], ny[:sm])
-        add_sources(out_m, near, n_near, M1X, M1Y, sx[:sm], sy[:sm], nx[:sm], ny[:sm], c)
+        add_sources(out_m, src[0], counts[0], M1X, M1Y, sx[:sm], sy[:sm], nx[:sm], ny[:sm], c)
         if walls:
             own_eod_images(out_m, axy[a], heading[a], img, c, sx[:sm], sy[:sm], nx[:sm], ny[:sm])
     if do_a:
         place_sensors(ax, ay, heading[a], tables[2, :sa], tables[3, :sa], c[R_SENS], sx[:sa], sy[:sa], nx[:sa], ny[:sa])
-        add_sources(out_a, near, n_near, M2X, M2Y, sx[:sa], sy[:sa], nx[:sa], ny[:sa], c)
-    if n_far > 0 and (do_m or do_a):
-        place_sensors(ax, ay, heading[a], tables[4, :nq], tables[5, :nq], c[R_SENS], sx[:nq], sy[:nq], nx[:nq], ny[:nq])
-        far_readings(far, n_far, sx[:nq], sy[:nq], nx[:nq], ny[:nq], c, scratch[4, :nq], scratch[5, :nq])
+        add_sources(out_a, src[0], counts[0], M2X, M2Y, sx[:sa], sy[:sa], nx[:sa], ny[:sa], c)
+    for lv in range(levels.shape[0]):
+        nq = levels[lv]
+        if counts[lv + 1] == 0 or not (do_m or do_a):
+            continue
+        place_sensors(ax, ay, heading[a], far_tables[lv, 0, :nq], far_tables[lv, 1, :nq], c[R_SENS],
+                      sx[:nq], sy[:nq], nx[:nq], ny[:nq])
+        far_readings(src[lv + 1], counts[lv + 1], sx[:nq], sy[:nq], nx[:nq], ny[:nq], c, scratch[4, :nq], scratch[5, :nq])
         if do_m:
-            interpolate_add(out_m, interp_m, scratch[4, :nq])
+            interpolate_add(out_m, interp_m[lv, :, :nq], scratch[4, :nq])
         if do_a:
-            interpolate_add(out_a, interp_a, scratch[5, :nq])
+            interpolate_add(out_a, interp_a[lv, :, :nq], scratch[5, :nq])
 
 
 @njit(cache=True, error_model="numpy")
 def sense_batch_kernel(agent_xy, heading, emitting, pellet_xy, pellet_phi, pellet_alive, width, height,
-                       img_idx, img_w, c, flags, tables, interp_m, interp_a, cos_k, sin_k,
+                       img_idx, img_w, c, flags, tables, levels, far_tables, interp_m, interp_a, cos_k, sin_k,
                        out_m, out_a, out_k):
     """Raw readings for B arenas. Positions in m, in the dtype of ``c``; outputs zeroed by the caller.
 
@@ -214,10 +230,12 @@ def sense_batch_kernel(agent_xy, heading, emitting, pellet_xy, pellet_phi, pelle
     b_count, n = agent_xy.shape[0], agent_xy.shape[1]
     nb_max = n + (pellet_xy.shape[1] if flags[DO_PELLETS] else 0)
     cap = nb_max * img_idx.shape[0]
-    src = np.empty((N_SRC, cap), c.dtype)
-    geo = np.empty((3, cap), np.float64)
-    scratch = np.empty((6, tables.shape[1]), c.dtype)
-    p_ind = np.zeros((nb_max, n, 2), c.dtype)
+    src = np.empty((levels.shape[0] + 1, N_SRC, cap), c.dtype)
+    counts = np.zeros(levels.shape[0] + 1, np.int64)
+    geo = np.empty((4, cap), np.float64)
+    scratch = np.empty((6, max(tables.shape[1], far_tables.shape[2])), c.dtype)
+    p_ind = np.zeros((n, 2, nb_max), c.dtype)  # per emitter: induced moments of every body
+    p_sum = np.zeros((2, nb_max), c.dtype)
     body = np.empty((7, nb_max), c.dtype)  # x, y, alpha, m1x, m1y, m2x, m2y
     for b in range(b_count):
         img = image_table(width[b], height[b], img_idx, img_w, c)
@@ -238,16 +256,19 @@ def sense_batch_kernel(agent_xy, heading, emitting, pellet_xy, pellet_phi, pelle
             for e in range(n):
                 induction = induction or emitting[b, e]
         if induction:
-            p_ind[:nb] = c[ZERO]
-            induced_dipoles(agent_xy[b], heading[b], emitting[b], body[0, :nb], body[1, :nb], body[2, :nb], img, c, p_ind)
+            induced_dipoles(agent_xy[b], heading[b], emitting[b], body[0, :nb], body[1, :nb], body[2, :nb], img, c,
+                            p_ind[:, :, :nb])
+            p_sum[:, :nb] = c[ZERO]
+            for e in range(n):
+                p_sum[:, :nb] += p_ind[e, :, :nb]
         for a in range(n if (flags[DO_MORM] or flags[DO_AMP]) else 0):
             if flags[DO_MORM] and induction:
-                mormyromast_moments(a, emitting[b], p_ind[:nb], c, body[3, :nb], body[4, :nb])
+                mormyromast_moments(a, emitting[b], p_ind[:, :, :nb], p_sum[:, :nb], c, body[3, :nb], body[4, :nb])
             else:
                 body[3, :nb] = c[ZERO]
                 body[4, :nb] = c[ZERO]
             sense_agent(a, agent_xy[b], heading[b], emitting[b], body[0, :nb], body[1, :nb], body[3, :nb],
-                        body[4, :nb], body[5, :nb], body[6, :nb], img, c, flags, tables, interp_m, interp_a,
-                        geo, src, scratch, out_m[b, a], out_a[b, a])
+                        body[4, :nb], body[5, :nb], body[6, :nb], img, c, flags, tables, levels, far_tables,
+                        interp_m, interp_a, geo, src, counts, scratch, out_m[b, a], out_a[b, a])
         if flags[DO_KNOLL]:
             knollenorgan_env(agent_xy[b], heading[b], emitting[b], cos_k, sin_k, c, flags, out_k[b])
