@@ -89,6 +89,6 @@ def sense(snapshot: Snapshot, cfg: EfishConfig | None = None, *, tolerance: floa
     """
     cfg = cfg or default_config()
     plan = build_plan(cfg, tolerance=tolerance, n_pellets=snapshot.n_pellets,
-                      any_emitter=bool(snapshot.agent_emitting.any()))
+                      any_emitter=bool(snapshot.agent_emitting.any()), n_agents=snapshot.n_agents)
     out = sense_batch(snapshot.as_batch(), plan, reference=reference, rng=rng, return_raw=return_raw)
     return {k: v[0] for k, v in out.items()}

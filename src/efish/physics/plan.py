@@ -112,13 +112,17 @@ class EffectPlan:
 
 
 def build_plan(cfg: EfishConfig, *, tolerance: float | None = None, dtype: str | None = None,
-               n_pellets: int | None = None, any_emitter: bool | None = None) -> EffectPlan:
+               n_pellets: int | None = None, any_emitter: bool | None = None,
+               n_agents: int | None = None) -> EffectPlan:
     """Decide which effects run for the scene in ``cfg`` and derive the kernel constants.
 
-    ``n_pellets`` and ``any_emitter`` refine the decision for a known episode
-    (no pellets -> no pellet loops; nobody can emit -> no induction).
+    ``n_pellets``, ``any_emitter`` and ``n_agents`` refine the decision for a
+    known episode (no pellets -> no pellet loops; nobody can emit -> no
+    induction; a lone agent -> no conspecific channels); they override the
+    scene config.
     """
     ph, se, sc = cfg.physics, cfg.sensors, cfg.scene
+    agents = sc.n_agents if n_agents is None else n_agents
     tol = ph.tolerance if tolerance is None else float(tolerance)
     if not tol >= 0:
         raise ValueError(f"tolerance must be >= 0, got {tolerance}")
@@ -139,8 +143,8 @@ def build_plan(cfg: EfishConfig, *, tolerance: float | None = None, dtype: str |
         Effect("fields", electric, "electric perception" if electric else "off: ray-casting baseline replaces all fields"),
         Effect("mormyromast", m_on, why_receptor("mormyromast", se.mormyromast.enabled)),
         Effect("ampullary", a_on, why_receptor("ampullary", se.ampullary.enabled)),
-        Effect("knollenorgan", k_on and emitters and sc.n_agents > 1,
-               "off: no conspecifics" if sc.n_agents < 2 else
+        Effect("knollenorgan", k_on and emitters and agents > 1,
+               "off: no conspecifics" if agents < 2 else
                ("off: nobody can emit, every spike is 0" if k_on and not emitters else why_receptor("knollenorgan", se.knollenorgan.enabled))),
         Effect("eod_emission", emitters, "agents may emit" if emitters else "off: emission disabled or every agent muted"),
         Effect("induction", m_on and emitters and ph.induction and gates_open,
@@ -148,10 +152,12 @@ def build_plan(cfg: EfishConfig, *, tolerance: float | None = None, dtype: str |
                "off: " + ("no Mormyromasts" if not m_on else "no emitters" if not emitters else
                           "physics.induction is false" if not ph.induction else "both gates closed")),
         Effect("self_part", m_on and se.mormyromast.g_self > 0, f"g_self = {se.mormyromast.g_self:g}"),
-        Effect("cons_part", m_on and se.mormyromast.g_cons > 0 and sc.n_agents > 1,
-               f"g_cons = {se.mormyromast.g_cons:g}" + ("" if sc.n_agents > 1 else ", but no conspecifics")),
-        Effect("wall_distortion", m_on and emitters and se.mormyromast.wall_distortion and walls,
-               "own EOD wall images added to the self part" if se.mormyromast.wall_distortion else "off: sensors.mormyromast.wall_distortion is false"),
+        Effect("cons_part", m_on and se.mormyromast.g_cons > 0 and agents > 1,
+               f"g_cons = {se.mormyromast.g_cons:g}" + ("" if agents > 1 else ", but no conspecifics")),
+        Effect("wall_distortion", m_on and emitters and se.mormyromast.wall_distortion and walls and se.mormyromast.g_self > 0,
+               "own EOD wall images added to the self part" if se.mormyromast.wall_distortion and se.mormyromast.g_self > 0
+               else "off: sensors.mormyromast.wall_distortion is false" if not se.mormyromast.wall_distortion
+               else "off: the self part is gated out (g_self = 0)"),
         Effect("intrinsic_fields", a_on and ph.intrinsic, "intrinsic dipoles feed Ampullary organs" if a_on and ph.intrinsic else
                "off: " + ("no Ampullary organs" if not a_on else "physics.intrinsic is false")),
         Effect("pellets", pellets, "pellet sources in the loops" if pellets else "off: the scene has no pellets"),

@@ -22,7 +22,7 @@ from numba import njit
 
 from .kernels import (
     _FASTMATH, ALPHA_AGENT, ALPHA_PELLET, CULL, DO_AMP, DO_INDUCTION, DO_KNOLL, DO_MORM, DO_PELLETS,
-    DO_WALLDIST, FAR_MIN2, FAR_SAFETY, G_CONS, G_SELF, HALF_SEP, K, K_CONS, KNOLL_ZERO, M1X, M1Y, M2X, M2Y, N_SRC, ONE,
+    DO_WALLDIST, FAR_MAX_X, FAR_SAFETY, G_CONS, G_SELF, HALF_SEP, K, K_CONS, KNOLL_ZERO, M1X, M1Y, M2X, M2Y, N_SRC, ONE,
     P_AGENT, P_PELLET, Q, R_SENS, SOFT2, SX, SY, TOL_AMP, TOL_MORM, ZERO, ZERO_AMP, ZERO_MORM,
     add_dipole, add_monopole, far_readings, image_table, induced_dipoles, place_sensors,
 )
@@ -33,7 +33,7 @@ def image_bounds(ax, ay, bx, by, img, r, geo):
     """Positions and unit-moment bounds 2 w / (D - r)^3 of every body image seen from (ax, ay).
 
     Branch-free over bodies so it vectorises; row k = i * bodies + j of ``geo``
-    holds (x, y, bound, distance D). A source inside the sensor circle gets a huge bound.
+    holds (x, y, bound, r / D). A source inside the sensor circle gets a huge bound.
     """
     nb = bx.shape[0]
     for i in range(img.shape[0]):
@@ -46,22 +46,24 @@ def image_bounds(ax, ay, bx, by, img, r, geo):
             geo[0, i * nb + j] = x
             geo[1, i * nb + j] = y
             geo[2, i * nb + j] = 2.0 * w / (gap * gap * gap)
-            geo[3, i * nb + j] = dist
+            geo[3, i * nb + j] = r / max(dist, 1e-100)
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def interpolation_level(dist, b1, b2, thr1, thr2, levels, c):
-    """Bucket of a source: the first level whose error bound is below both thresholds; 0 = exact."""
-    if dist * dist < c[FAR_MIN2]:
+def interpolation_level(x, significance, levels, c):
+    """Bucket of a source seen at x = r / D with bound / threshold = ``significance``.
+
+    The first level whose error bound C Q x^((Q+1)/2) * significance stays <= 1; 0 = exact.
+    """
+    if x > c[FAR_MAX_X]:
         return 0
-    allowed = min(thr1 / b1 if b1 > 0 else np.inf, thr2 / b2 if b2 > 0 else np.inf)
-    x = c[R_SENS] / dist
+    budget = 1.0 / (c[FAR_SAFETY] * significance)
     power, order = 1.0, 0
     for lv in range(levels.shape[0]):
         while order < (levels[lv] + 1) // 2:
             power *= x
             order += 1
-        if c[FAR_SAFETY] * levels[lv] * power <= allowed:
+        if levels[lv] * power <= budget:
             return lv + 1
     return 0
 
@@ -78,6 +80,8 @@ def gather_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, img, c, thr1, thr2, le
     nb = bx.shape[0]
     image_bounds(ax, ay, bx, by, img, c[R_SENS], geo)
     counts[:] = 0
+    inv1 = 1.0 / thr1 if thr1 > 0 else 0.0
+    inv2 = 1.0 / thr2 if thr2 > 0 else 0.0
     total1 = total2 = 0.0  # bounds steer decisions only: float64 whatever the dtype
     for j in range(nb):
         mag1 = np.sqrt(m1x[j] * m1x[j] + m1y[j] * m1y[j])
@@ -93,7 +97,8 @@ def gather_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, img, c, thr1, thr2, le
             keep1, keep2 = mag1 > 0 and b1 >= thr1, b2 > 0 and b2 >= thr2
             if not (keep1 or keep2):
                 continue
-            lv = interpolation_level(geo[3, k], b1 if keep1 else 0.0, b2 if keep2 else 0.0, thr1, thr2, levels, c)
+            significance = max(b1 * inv1 if keep1 else 0.0, b2 * inv2 if keep2 else 0.0)
+            lv = interpolation_level(geo[3, k], significance, levels, c)
             q = counts[lv]
             counts[lv] += 1
             w = img[i, 4]
@@ -106,19 +111,27 @@ def gather_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, img, c, thr1, thr2, le
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def mormyromast_moments(a, emitting, p_ind, p_sum, c, mx, my):
+def mormyromast_moments(a, emitting, p_ind, c, mx, my):
     """g_self * self + g_cons * gain * cons moment of every body for agent ``a`` (k folded in).
 
-    self = p_ind[a] (zero when a is silent), cons = p_sum - p_ind[a]; gain =
-    k_cons when ``a`` is silent or g_self = 0 (SPEC 3.1). The agent's own
-    induced dipole is excluded (the body is the sensor).
+    self = p_ind[a] (zero when a is silent), cons = sum of p_ind[e] over the
+    other emitters; gain = k_cons when ``a`` is silent or g_self = 0 (SPEC 3.1).
+    The agent's own induced dipole is excluded (the body is the sensor).
+    cons is summed directly, not formed as p_sum - p_ind[a]: near an emitting
+    agent self >> cons, and the difference would lose cons to round-off (in
+    float32 by up to ~0.3 after normalisation, times k_cons in cons-only runs).
     """
     gain = c[K_CONS] if (not emitting[a] or c[G_SELF] == 0) else c[ONE]
     w_cons = c[G_CONS] * gain * c[K]
-    w_self = c[G_SELF] * c[K] - w_cons
+    w_self = c[G_SELF] * c[K]
     for j in range(mx.shape[0]):
-        mx[j] = w_cons * p_sum[0, j] + w_self * p_ind[a, 0, j]
-        my[j] = w_cons * p_sum[1, j] + w_self * p_ind[a, 1, j]
+        mx[j] = w_self * p_ind[a, 0, j]
+        my[j] = w_self * p_ind[a, 1, j]
+    for e in range(emitting.shape[0]):
+        if e != a and emitting[e]:
+            for j in range(mx.shape[0]):
+                mx[j] += w_cons * p_ind[e, 0, j]
+                my[j] += w_cons * p_ind[e, 1, j]
     mx[a] = c[ZERO]
     my[a] = c[ZERO]
 
@@ -172,13 +185,15 @@ def add_sources(out, src, count, col_x, col_y, sx, sy, nx, ny, c):
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def interpolate_add(out, matrix, values):
-    """out += matrix @ values (trigonometric interpolation from far-field points to sensors)."""
-    for s in range(out.shape[0]):
-        acc = values[0] * 0
-        for q in range(values.shape[0]):
-            acc += matrix[s, q] * values[q]
-        out[s] += acc
+def interpolate_add(out, matrix_t, values):
+    """out += matrix_t.T @ values: trigonometric interpolation from level points to sensors.
+
+    ``matrix_t`` is (points, sensors), so the inner loop runs over contiguous sensors.
+    """
+    for q in range(values.shape[0]):
+        v = values[q]
+        for s in range(out.shape[0]):
+            out[s] += matrix_t[q, s] * v
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
@@ -194,7 +209,7 @@ def sense_agent(a, axy, heading, emitting, bx, by, m1x, m1y, m2x, m2y, img, c, f
     thr1 = c[TOL_MORM] if flags[CULL] else -1.0
     thr2 = c[TOL_AMP] if flags[CULL] else -1.0
     tot1, tot2 = gather_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, img, c, thr1, thr2, levels, geo, src, counts)
-    walls = flags[DO_WALLDIST] and emitting[a] and img.shape[0] > 1
+    walls = flags[DO_WALLDIST] and emitting[a] and img.shape[0] > 1 and c[G_SELF] != 0
     do_m = flags[DO_MORM] and (walls or not flags[CULL] or tot1 > c[ZERO_MORM])
     do_a = flags[DO_AMP] and (not flags[CULL] or tot2 > c[ZERO_AMP])
     sx, sy, nx, ny = scratch[0], scratch[1], scratch[2], scratch[3]
@@ -214,9 +229,9 @@ def sense_agent(a, axy, heading, emitting, bx, by, m1x, m1y, m2x, m2y, img, c, f
                       sx[:nq], sy[:nq], nx[:nq], ny[:nq])
         far_readings(src[lv + 1], counts[lv + 1], sx[:nq], sy[:nq], nx[:nq], ny[:nq], c, scratch[4, :nq], scratch[5, :nq])
         if do_m:
-            interpolate_add(out_m, interp_m[lv, :, :nq], scratch[4, :nq])
+            interpolate_add(out_m, interp_m[lv, :nq], scratch[4, :nq])
         if do_a:
-            interpolate_add(out_a, interp_a[lv, :, :nq], scratch[5, :nq])
+            interpolate_add(out_a, interp_a[lv, :nq], scratch[5, :nq])
 
 
 @njit(cache=True, error_model="numpy")
@@ -235,7 +250,6 @@ def sense_batch_kernel(agent_xy, heading, emitting, pellet_xy, pellet_phi, pelle
     geo = np.empty((4, cap), np.float64)
     scratch = np.empty((6, max(tables.shape[1], far_tables.shape[2])), c.dtype)
     p_ind = np.zeros((n, 2, nb_max), c.dtype)  # per emitter: induced moments of every body
-    p_sum = np.zeros((2, nb_max), c.dtype)
     body = np.empty((7, nb_max), c.dtype)  # x, y, alpha, m1x, m1y, m2x, m2y
     for b in range(b_count):
         img = image_table(width[b], height[b], img_idx, img_w, c)
@@ -258,12 +272,9 @@ def sense_batch_kernel(agent_xy, heading, emitting, pellet_xy, pellet_phi, pelle
         if induction:
             induced_dipoles(agent_xy[b], heading[b], emitting[b], body[0, :nb], body[1, :nb], body[2, :nb], img, c,
                             p_ind[:, :, :nb])
-            p_sum[:, :nb] = c[ZERO]
-            for e in range(n):
-                p_sum[:, :nb] += p_ind[e, :, :nb]
         for a in range(n if (flags[DO_MORM] or flags[DO_AMP]) else 0):
             if flags[DO_MORM] and induction:
-                mormyromast_moments(a, emitting[b], p_ind[:, :, :nb], p_sum[:, :nb], c, body[3, :nb], body[4, :nb])
+                mormyromast_moments(a, emitting[b], p_ind[:, :, :nb], c, body[3, :nb], body[4, :nb])
             else:
                 body[3, :nb] = c[ZERO]
                 body[4, :nb] = c[ZERO]

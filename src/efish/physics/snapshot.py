@@ -68,6 +68,8 @@ class Snapshot:
         emitting = np.asarray(self.agent_emitting)
         if emitting.shape != (n,):
             raise ValueError(f"agent_emitting must have shape ({n},) to match agent_xy, got {emitting.shape}")
+        if emitting.dtype != bool and not np.all(np.isin(emitting, (0, 1))):
+            raise ValueError("agent_emitting must hold booleans (or 0/1)")
         set_(self, "agent_emitting", emitting.astype(bool))
         pxy = np.zeros((0, 2)) if self.pellet_xy is None else self.pellet_xy
         pxy = _float_array("pellet_xy", np.reshape(pxy, (-1, 2)) if np.size(pxy) == 0 else pxy, (2,), 2)

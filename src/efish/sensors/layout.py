@@ -14,8 +14,8 @@ def mormyromast_angles(cfg: MormyromastConfig) -> np.ndarray:
     30 + k * 300/27 degrees for k = 1..26, so neither chin end is repeated.
 
     >>> a = np.degrees(mormyromast_angles(MormyromastConfig()))
-    >>> len(a), a[0], a[9], round(a[10], 3)
-    (36, -30.0, 30.0, 41.111)
+    >>> print(len(a), f"{a[0]:.1f} {a[9]:.1f} {a[10]:.3f}")
+    36 -30.0 30.0 41.111
     """
     half = cfg.chin_half_angle_deg
     chin = np.linspace(-half, half, cfg.chin_count) if cfg.chin_count > 1 else np.zeros(cfg.chin_count)

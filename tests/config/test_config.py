@@ -1,0 +1,116 @@
+"""Config composition and validation: every failure is one ConfigError line naming the key."""
+
+from __future__ import annotations
+
+import pytest
+
+from efish.config import ConfigError, EfishConfig, compose, to_yaml, validate
+
+from ..conftest import cfg_with
+
+
+def test_default_config_matches_the_spec(default_cfg):
+    ph, se = default_cfg.physics, default_cfg.sensors
+    assert isinstance(default_cfg, EfishConfig)
+    assert ph.eps0 == 8.854e-12 and ph.eod_charge_c == 1.11e-15 and ph.eod_half_separation_cm == 0.5
+    assert ph.agent_dipole_cm == 1.11e-23 and ph.pellet_dipole_cm == 1.11e-24
+    assert ph.susceptibility == -0.5 and ph.agent_radius_cm == 1.0 and ph.pellet_radius_cm == 0.25
+    assert ph.softening_m == 1e-5 and ph.image_order == 1 and ph.image_scale == 0.95
+    assert (se.mormyromast.count, se.ampullary.count, se.knollenorgan.count) == (36, 24, 12)
+    assert (se.mormyromast.e_min, se.mormyromast.e_max) == (5e-8, 5e-2)
+    assert (se.ampullary.e_min, se.ampullary.e_max) == (2e-10, 2e-8)
+    assert se.knollenorgan.threshold == 2e-7
+    assert (se.mormyromast.g_self, se.mormyromast.g_cons, se.mormyromast.k_cons) == (1.0, 1.0, 100.0)
+    assert not se.mormyromast.wall_distortion
+    assert (se.noise.low, se.noise.high, se.noise.interference_low, se.noise.interference_high) == (0.95, 1.05, 0.0, 2.0)
+
+
+def test_overrides_are_applied():
+    cfg = cfg_with("physics.image_order=2", "sensors.knollenorgan.enabled=false", "physics.dtype=float32")
+    assert cfg.physics.image_order == 2 and not cfg.sensors.knollenorgan.enabled
+    assert cfg.physics.dtype == "float32"
+
+
+def test_to_yaml_round_trips_the_values(default_cfg):
+    text = to_yaml(default_cfg)
+    assert "image_order: 1" in text and "threshold: 2.0e-07" in text
+
+
+def one_line_error(overrides) -> str:
+    with pytest.raises(ConfigError) as info:
+        compose(overrides)
+    msg = str(info.value)
+    assert "\n" not in msg and msg.strip() == msg and msg
+    return msg
+
+
+@pytest.mark.parametrize("override, key", [
+    ("physics.bogus=1", "physics.bogus"),
+    ("sensors.mormyromast.bogus=3", "sensors.mormyromast.bogus"),
+    ("nonsense=1", "nonsense"),
+])
+def test_unknown_key(override, key):
+    msg = one_line_error([override])
+    assert key in msg and "unknown" in msg
+
+
+@pytest.mark.parametrize("override, key", [
+    ("physics.image_order=5", "physics.image_order"),
+    ("physics.image_order=-1", "physics.image_order"),
+    ("physics.softening_m=-1", "physics.softening_m"),
+    ("physics.image_scale=1.5", "physics.image_scale"),
+    ("scene.n_agents=0", "scene.n_agents"),
+    ("sensors.mormyromast.count=0", "sensors.mormyromast.count"),
+])
+def test_out_of_range_value(override, key):
+    msg = one_line_error([override])
+    assert key in msg and "range" in msg
+
+
+@pytest.mark.parametrize("override, key", [
+    ("physics.image_order=abc", "physics.image_order"),
+    ("physics.tolerance=abc", "physics.tolerance"),
+    ("physics.emission=maybe", "physics.emission"),
+    ("sensors.noise.low=[1,2]", "sensors.noise.low"),
+])
+def test_bad_type(override, key):
+    msg = one_line_error([override])
+    assert key in msg
+
+
+@pytest.mark.parametrize("override, key", [
+    ("physics.dtype=float16", "physics.dtype"),
+    ("sensors.perception=sonar", "sensors.perception"),
+    ("sensors.mormyromast.g_self=0.5", "sensors.mormyromast.g_self"),
+    ("scene.emitters=some", "scene.emitters"),
+])
+def test_bad_choice(override, key):
+    msg = one_line_error([override])
+    assert key in msg and "allowed" in msg
+
+
+@pytest.mark.parametrize("overrides, key", [
+    (["sensors.mormyromast.e_min=1"], "sensors.mormyromast.e_min"),
+    (["sensors.ampullary.e_max=1e-12"], "sensors.ampullary.e_min"),
+    (["sensors.mormyromast.chin_count=40"], "sensors.mormyromast.chin_count"),
+    (["sensors.noise.low=1.2"], "sensors.noise.low"),
+])
+def test_inconsistent_values(overrides, key):
+    assert key in one_line_error(overrides)
+
+
+def test_missing_config_group_option_is_one_line():
+    msg = one_line_error(["scene=nope"])
+    assert "scene" in msg
+
+
+def test_validate_names_the_key_of_a_mutated_tree(default_cfg):
+    from copy import deepcopy
+    cfg = deepcopy(default_cfg)
+    cfg.sensors.ampullary.count = 0
+    with pytest.raises(ConfigError, match=r"sensors\.ampullary\.count"):
+        validate(cfg)
+
+
+def test_config_error_is_a_value_error():
+    assert issubclass(ConfigError, ValueError)
