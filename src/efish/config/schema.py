@@ -205,8 +205,10 @@ def validate(obj: Any, path: str = "") -> None:
 
 def _check_consistency(obj: Any, path: str) -> None:
     """Cross-field rules that a single range cannot express."""
-    if isinstance(obj, PhysicsConfig) and any(q % 2 == 0 or not 3 <= q <= 63 for q in obj.far_field_levels):
-        raise ConfigError(f"{path}far_field_levels={list(obj.far_field_levels)} must hold odd counts in [3, 63]")
+    if isinstance(obj, PhysicsConfig):
+        levels = list(obj.far_field_levels)
+        if any(q % 2 == 0 or not 3 <= q <= 63 for q in levels) or levels != sorted(set(levels)):
+            raise ConfigError(f"{path}far_field_levels={levels} must hold increasing odd counts in [3, 63]")
     if isinstance(obj, (MormyromastConfig, AmpullaryConfig)) and not 0 < obj.e_min < obj.e_max:
         raise ConfigError(f"{path}e_min={obj.e_min:g} must be > 0 and below {path}e_max={obj.e_max:g}")
     if isinstance(obj, MormyromastConfig) and obj.chin_count > obj.count:

@@ -27,8 +27,8 @@ def kernel_constants(plan: EffectPlan) -> tuple[np.ndarray, np.ndarray]:
     c[kn.KNOLL_ZERO] = plan.knollen_threshold / plan.max_noise
     c[kn.G_SELF], c[kn.G_CONS], c[kn.K_CONS] = plan.g_self, plan.g_cons, plan.k_cons
     c[kn.ONE], c[kn.TWO], c[kn.THREE], c[kn.ZERO] = 1.0, 2.0, 3.0, 0.0
-    c[kn.FAR_MAX_X] = plan.sensor_radius / plan.far_min if plan.far_levels else -1.0  # r / D above this: exact
-    c[kn.FAR_SAFETY] = plan.far_safety
+    # log2(r / D) above this: the source is too close to interpolate
+    c[kn.FAR_MAX_LX] = np.log2(plan.sensor_radius / plan.far_min) if plan.far_levels else -np.inf
     f = np.zeros(kn.N_FLAGS, dtype=np.int64)
     f[kn.DO_MORM] = plan.on("mormyromast") and (plan.on("induction") or plan.on("wall_distortion"))
     f[kn.DO_AMP] = plan.on("ampullary") and plan.on("intrinsic_fields")
@@ -63,8 +63,17 @@ def fast_raw(batch: SnapshotBatch, plan: EffectPlan) -> RawReadings:
         arr(batch.agent_xy, CM), arr(batch.agent_heading), emitting,
         arr(batch.pellet_xy, CM), arr(batch.pellet_orientation), np.ascontiguousarray(batch.pellet_alive),
         arr(batch.width, CM), arr(batch.height, CM), plan.image_indices, arr(plan.image_weights), c, flags,
-        arr(tables), np.array(plan.far_levels, dtype=np.int64), arr(plan.far_tables),
+        arr(tables), np.array(plan.far_levels, dtype=np.int64), *level_tables(plan), arr(plan.far_tables),
         arr(plan.morm_interp.transpose(0, 2, 1)), arr(plan.amp_interp.transpose(0, 2, 1)),
         arr(np.cos(plan.knollen_angles)), arr(np.sin(plan.knollen_angles)),
         out.mormyromast, out.ampullary, out.knollenorgan)
     return out
+
+
+def level_tables(plan: EffectPlan) -> tuple[np.ndarray, np.ndarray]:
+    """Lookup tables of the far-field level choice (see ``sense_kernel.interpolation_level``).
+
+    level_lcq: log2(C Q) per level; level_e: the order (Q + 1) / 2 per level.
+    """
+    q = np.array(plan.far_levels, dtype=np.float64)
+    return np.log2(plan.far_safety * q), (q + 1) // 2

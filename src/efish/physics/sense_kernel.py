@@ -17,12 +17,14 @@ every sensor). ``efish bench accuracy`` measures the result.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
 
 from .kernels import (
     _FASTMATH, ALPHA_AGENT, ALPHA_PELLET, CULL, DO_AMP, DO_INDUCTION, DO_KNOLL, DO_MORM, DO_PELLETS,
-    DO_WALLDIST, FAR_MAX_X, FAR_SAFETY, G_CONS, G_SELF, HALF_SEP, K, K_CONS, KNOLL_ZERO, M1X, M1Y, M2X, M2Y, N_SRC, ONE,
+    DO_WALLDIST, FAR_MAX_LX, G_CONS, G_SELF, HALF_SEP, K, K_CONS, KNOLL_ZERO, M1X, M1Y, M2X, M2Y, N_SRC, ONE,
     P_AGENT, P_PELLET, Q, R_SENS, SOFT2, SX, SY, TOL_AMP, TOL_MORM, ZERO, ZERO_AMP, ZERO_MORM,
     add_dipole, add_monopole, far_readings, image_table, induced_dipoles, place_sensors,
 )
@@ -30,10 +32,11 @@ from .kernels import (
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
 def image_bounds(ax, ay, bx, by, img, r, geo):
-    """Positions and unit-moment bounds 2 w / (D - r)^3 of every body image seen from (ax, ay).
+    """Positions, unit-moment bounds 2 w / (D - r)^3 and D^2 of every body image seen from (ax, ay).
 
-    Branch-free over bodies so it vectorises; row k = i * bodies + j of ``geo``
-    holds (x, y, bound, r / D). A source inside the sensor circle gets a huge bound.
+    Branch-free over bodies so it vectorises; column k = i * bodies + j of
+    ``geo`` holds rows (x, y, bound, D^2). A source inside the sensor circle
+    gets a huge bound.
     """
     nb = bx.shape[0]
     for i in range(img.shape[0]):
@@ -41,54 +44,88 @@ def image_bounds(ax, ay, bx, by, img, r, geo):
         for j in range(nb):
             x = ox + sx * bx[j]
             y = oy + sy * by[j]
-            dist = np.sqrt((x - ax) * (x - ax) + (y - ay) * (y - ay))
-            gap = max(dist - r, 1e-100)
+            d2 = (x - ax) * (x - ax) + (y - ay) * (y - ay)
+            gap = max(np.sqrt(d2) - r, 1e-100)
             geo[0, i * nb + j] = x
             geo[1, i * nb + j] = y
             geo[2, i * nb + j] = 2.0 * w / (gap * gap * gap)
-            geo[3, i * nb + j] = r / max(dist, 1e-100)
+            geo[3, i * nb + j] = d2
+
+
+MITCHELL_ERROR = 0.0861  # max of log2(1 + f) - f on [0, 1]: the bit-pattern log2 is at most this low
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def interpolation_level(x, significance, levels, c):
-    """Bucket of a source seen at x = r / D with bound / threshold = ``significance``.
+def log2_upper(values, out):
+    """out >= log2(values) within 0.09, from the float bit pattern (Mitchell); vectorises, no libm call."""
+    bits = values.view(np.int64)
+    for k in range(values.shape[0]):
+        out[k] = bits[k] * 2.0 ** -52 - 1023.0 + MITCHELL_ERROR
 
-    The first level whose error bound C Q x^((Q+1)/2) * significance stays <= 1; 0 = exact.
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def interpolation_levels(n_img, body_log_sig, geo, level_lcq, level_e, c, out):
+    """Bucket of every source: the first level whose error bound C Q B x^e stays <= the threshold.
+
+    In log2 the condition of level l is log2(C Q_l) + ls + e_l lx <= 0, with
+    upper bounds ``ls`` >= log2(bound / threshold) (body part in
+    ``body_log_sig``, distance part in ``geo`` row 4) and lx >= log2(r / D)
+    (from ``geo`` row 5), so the choice errs towards accuracy. The bound falls
+    with the level, so the bucket is 1 + the number of failing levels, or 0
+    (exact) when every level fails or the source is closer than the far-field
+    minimum. Written as counts over levels, branch-free, so it vectorises.
     """
-    if x > c[FAR_MAX_X]:
-        return 0
-    budget = 1.0 / (c[FAR_SAFETY] * significance)
-    power, order = 1.0, 0
-    for lv in range(levels.shape[0]):
-        while order < (levels[lv] + 1) // 2:
-            power *= x
-            order += 1
-        if levels[lv] * power <= budget:
-            return lv + 1
-    return 0
+    nb, n_lv = body_log_sig.shape[0], level_e.shape[0]
+    n = nb * n_img
+    log2_r = math.log2(c[R_SENS])
+    lx, ls = geo[5, :n], geo[4, :n]
+    for i in range(n_img):  # rows 4-5 become ls and lx in place
+        for j in range(nb):
+            k = i * nb + j
+            lx[k] = log2_r - 0.5 * (lx[k] - MITCHELL_ERROR)
+            ls[k] = body_log_sig[j] + ls[k]
+    out[:n] = 0
+    for lv in range(n_lv):  # levels outermost: the loop over sources vectorises
+        lcq, e = level_lcq[lv], level_e[lv]
+        for k in range(n):
+            out[k] += lcq + ls[k] + e * lx[k] > 0
+    for k in range(n):
+        out[k] = 0 if (out[k] == n_lv or lx[k] > c[FAR_MAX_LX]) else out[k] + 1
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def gather_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, img, c, thr1, thr2, levels, geo, src, counts):
+def gather_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, img, c, thr1, thr2, level_lcq, level_e,
+                   geo, level, src, counts):
     """Images of body moments whose bound at agent ``a`` reaches a threshold, bucketed by level.
 
     Column 1 (Mormyromast) and column 2 (Ampullary) are culled separately; a
     culled column is stored as 0. The agent's own intrinsic dipole enters only
     through its images. ``src[level, :, :counts[level]]`` receives the sources.
-    Returns the bound sums of both columns.
+    ``geo`` rows 4-5 receive upper bounds of log2(bound) and log2(D^2), ``level``
+    the bucket of every source. Returns the bound sums of both columns.
     """
-    nb = bx.shape[0]
+    nb, n_img = bx.shape[0], img.shape[0]
     image_bounds(ax, ay, bx, by, img, c[R_SENS], geo)
-    counts[:] = 0
     inv1 = 1.0 / thr1 if thr1 > 0 else 0.0
     inv2 = 1.0 / thr2 if thr2 > 0 else 0.0
+    level[:nb * n_img] = 0
+    if level_e.shape[0] > 0:
+        log2_upper(geo[2, :nb * n_img], geo[4, :nb * n_img])
+        log2_upper(geo[3, :nb * n_img], geo[5, :nb * n_img])
+        # log2(moment / threshold), the larger column: a conservative significance per body
+        body = np.empty(nb)
+        for j in range(nb):
+            body[j] = max(m1x[j] * m1x[j] + m1y[j] * m1y[j], 0.0) * inv1 * inv1
+            body[j] = 0.5 * math.log2(max(body[j], (m2x[j] * m2x[j] + m2y[j] * m2y[j]) * inv2 * inv2, 1e-300))
+        interpolation_levels(n_img, body, geo, level_lcq, level_e, c, level)
+    counts[:] = 0
     total1 = total2 = 0.0  # bounds steer decisions only: float64 whatever the dtype
     for j in range(nb):
         mag1 = np.sqrt(m1x[j] * m1x[j] + m1y[j] * m1y[j])
         mag2 = np.sqrt(m2x[j] * m2x[j] + m2y[j] * m2y[j])
         if mag1 == 0 and mag2 == 0:
             continue
-        for i in range(img.shape[0]):
+        for i in range(n_img):
             k = i * nb + j
             b1 = mag1 * geo[2, k]
             b2 = mag2 * geo[2, k] if not (j == a and i == 0) else 0.0
@@ -97,8 +134,7 @@ def gather_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, img, c, thr1, thr2, le
             keep1, keep2 = mag1 > 0 and b1 >= thr1, b2 > 0 and b2 >= thr2
             if not (keep1 or keep2):
                 continue
-            significance = max(b1 * inv1 if keep1 else 0.0, b2 * inv2 if keep2 else 0.0)
-            lv = interpolation_level(geo[3, k], significance, levels, c)
+            lv = level[k]
             q = counts[lv]
             counts[lv] += 1
             w = img[i, 4]
@@ -198,7 +234,7 @@ def interpolate_add(out, matrix_t, values):
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
 def sense_agent(a, axy, heading, emitting, bx, by, m1x, m1y, m2x, m2y, img, c, flags, tables, levels,
-                far_tables, interp_m, interp_a, geo, src, counts, scratch, out_m, out_a):
+                level_lcq, level_e, far_tables, interp_m, interp_a, geo, level, src, counts, scratch, out_m, out_a):
     """Mormyromast and Ampullary raw readings of agent ``a``.
 
     ``tables`` rows 0-1 / 2-3: cos, sin of Mormyromast / Ampullary angles.
@@ -208,7 +244,8 @@ def sense_agent(a, axy, heading, emitting, bx, by, m1x, m1y, m2x, m2y, img, c, f
     ax, ay = axy[a, 0], axy[a, 1]
     thr1 = c[TOL_MORM] if flags[CULL] else -1.0
     thr2 = c[TOL_AMP] if flags[CULL] else -1.0
-    tot1, tot2 = gather_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, img, c, thr1, thr2, levels, geo, src, counts)
+    tot1, tot2 = gather_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, img, c, thr1, thr2, level_lcq, level_e,
+                                geo, level, src, counts)
     walls = flags[DO_WALLDIST] and emitting[a] and img.shape[0] > 1 and c[G_SELF] != 0
     do_m = flags[DO_MORM] and (walls or not flags[CULL] or tot1 > c[ZERO_MORM])
     do_a = flags[DO_AMP] and (not flags[CULL] or tot2 > c[ZERO_AMP])
@@ -236,7 +273,8 @@ def sense_agent(a, axy, heading, emitting, bx, by, m1x, m1y, m2x, m2y, img, c, f
 
 @njit(cache=True, error_model="numpy")
 def sense_batch_kernel(agent_xy, heading, emitting, pellet_xy, pellet_phi, pellet_alive, width, height,
-                       img_idx, img_w, c, flags, tables, levels, far_tables, interp_m, interp_a, cos_k, sin_k,
+                       img_idx, img_w, c, flags, tables, levels, level_lcq, level_e, far_tables,
+                       interp_m, interp_a, cos_k, sin_k,
                        out_m, out_a, out_k):
     """Raw readings for B arenas. Positions in m, in the dtype of ``c``; outputs zeroed by the caller.
 
@@ -247,7 +285,8 @@ def sense_batch_kernel(agent_xy, heading, emitting, pellet_xy, pellet_phi, pelle
     cap = nb_max * img_idx.shape[0]
     src = np.empty((levels.shape[0] + 1, N_SRC, cap), c.dtype)
     counts = np.zeros(levels.shape[0] + 1, np.int64)
-    geo = np.empty((4, cap), np.float64)
+    geo = np.empty((6, cap), np.float64)
+    level = np.zeros(cap, np.int64)
     scratch = np.empty((6, max(tables.shape[1], far_tables.shape[2])), c.dtype)
     p_ind = np.zeros((n, 2, nb_max), c.dtype)  # per emitter: induced moments of every body
     body = np.empty((7, nb_max), c.dtype)  # x, y, alpha, m1x, m1y, m2x, m2y
@@ -279,7 +318,7 @@ def sense_batch_kernel(agent_xy, heading, emitting, pellet_xy, pellet_phi, pelle
                 body[3, :nb] = c[ZERO]
                 body[4, :nb] = c[ZERO]
             sense_agent(a, agent_xy[b], heading[b], emitting[b], body[0, :nb], body[1, :nb], body[3, :nb],
-                        body[4, :nb], body[5, :nb], body[6, :nb], img, c, flags, tables, levels, far_tables,
-                        interp_m, interp_a, geo, src, counts, scratch, out_m[b, a], out_a[b, a])
+                        body[4, :nb], body[5, :nb], body[6, :nb], img, c, flags, tables, levels, level_lcq, level_e, far_tables,
+                        interp_m, interp_a, geo, level, src, counts, scratch, out_m[b, a], out_a[b, a])
         if flags[DO_KNOLL]:
             knollenorgan_env(agent_xy[b], heading[b], emitting[b], cos_k, sin_k, c, flags, out_k[b])
