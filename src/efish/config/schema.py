@@ -50,7 +50,7 @@ class PhysicsConfig:
     emission: bool = param(True, "agents may emit EODs at all")
     intrinsic: bool = param(True, "intrinsic (always-on) dipoles of agents and pellets exist")
     induction: bool = param(True, "bodies are polarised by EOD fields (induced dipoles)")
-    tolerance: float = param(1e-9, "skip a source when a bound on its field is below tolerance * E_min; 0 = exact", lo=0.0, hi=1e3)
+    tolerance: float = param(1e-7, "skip a source when a bound on its field is below tolerance * E_min; 0 = exact", lo=0.0, hi=1e3)
     dtype: str = param("float64", "floating type of the field kernels", choices=("float64", "float32"))
     far_field_levels: list = param([3, 5, 7, 9, 13, 17, 21, 31], "point counts (odd) a distant source may be interpolated from; [] = off")
     far_field_min_cm: float = param(3.0, "sources closer than this are always evaluated at every sensor, cm", lo=1.0)
