@@ -140,7 +140,8 @@ def plot_accuracy(df: pd.DataFrame, path: str | Path) -> None:
                ylabel=f"max |error| of normalised readings (floor {floor:g})", title=title)
     base = df[df.is_default].iloc[0] if df["is_default"].any() else None
     series = df.iloc[:0] if base is None else df[
-        (df.image_order == base.image_order) & (df.dtype == base.dtype) & (df.softening_m == base.softening_m) & df.far_field]
+        (df["image_order"] == base["image_order"]) & (df["dtype"] == base["dtype"])
+        & (df["softening_m"] == base["softening_m"]) & df["far_field"]]
     for _, row in series.iterrows():
         axes[1].annotate(f"tol {row.tolerance:g}", (row.us_per_agent_step, max(row.max_abs_error_same_model, floor)),
                          fontsize=6, xytext=(3, 3), textcoords="offset points")
