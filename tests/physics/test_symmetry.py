@@ -9,6 +9,10 @@ mirror image; the pellet dipole (pellet +y, i.e. (-sin phi, cos phi)) mirrors to
 from the heading lands at -alpha, and its outward normal n maps to M n, so the
 reading E.n = (M E).(M n) is unchanged: readings are permuted, never negated.
 The arena [0, W] x [0, H] maps onto itself, so the wall images mirror too.
+
+Symmetry is exact for the model: at tolerance 0 readings agree to 1e-9. At the
+default tolerance the fast path culls and interpolates (in float32) and is held
+to its accuracy target instead, 1e-6 in normalised units.
 """
 
 from __future__ import annotations
@@ -74,11 +78,15 @@ def disk_scene(seed: int, n_agents: int, n_pellets: int, size: float = 70.0) -> 
                     width=size, height=size)
 
 
-def assert_same_readings(a: dict, b: dict, e_min: dict) -> None:
+TOLERANCES = [pytest.param(0.0, id="exact"), pytest.param(None, id="default-tolerance")]
+
+
+def assert_same_readings(a: dict, b: dict, e_min: dict, tolerance: float | None = 0.0) -> None:
+    exact = tolerance == 0.0
     for name in RAW:
-        np.testing.assert_allclose(b[f"{name}_raw"], a[f"{name}_raw"], rtol=1e-9, atol=1e-6 * e_min[name],
-                                   err_msg=name)
-        np.testing.assert_allclose(b[name], a[name], rtol=0, atol=1e-9, err_msg=name)
+        np.testing.assert_allclose(b[f"{name}_raw"], a[f"{name}_raw"], rtol=1e-9 if exact else 1e-5,
+                                   atol=(1e-6 if exact else 1e-5) * e_min[name], err_msg=name)
+        np.testing.assert_allclose(b[name], a[name], rtol=0, atol=1e-9 if exact else 1e-6, err_msg=name)
     np.testing.assert_array_equal(b["knollen_size"], a["knollen_size"])
 
 
@@ -110,16 +118,17 @@ MIRROR_CASES = [
 ]
 
 
+@pytest.mark.parametrize("tolerance", TOLERANCES)
 @pytest.mark.parametrize("overrides", MIRROR_CASES)
 @pytest.mark.parametrize("seed", [0, 1, 2])
-def test_mirrored_scene_gives_mirrored_readings(overrides, seed):
+def test_mirrored_scene_gives_mirrored_readings(overrides, seed, tolerance):
     cfg = cfg_with(*overrides)
     rng = np.random.default_rng(seed)
     s = random_snapshot(rng, 4, 60, width=50.0, height=40.0)
-    a = sense(s, cfg, return_raw=True)
-    b = sense(mirrored(s), cfg, return_raw=True)
+    a = sense(s, cfg, return_raw=True, tolerance=tolerance)
+    b = sense(mirrored(s), cfg, return_raw=True, tolerance=tolerance)
     assert any(np.any(a[name] != 0) for name in ("mormyromast", "ampullary"))
-    assert_same_readings(permuted(a, cfg), b, ranges(cfg))
+    assert_same_readings(permuted(a, cfg), b, ranges(cfg), tolerance)
 
 
 def test_mirror_test_is_sensitive_to_a_wrongly_mirrored_pellet():
@@ -130,29 +139,31 @@ def test_mirror_test_is_sensitive_to_a_wrongly_mirrored_pellet():
                  pellet_xy=[[22.5, 20.5]], pellet_orientation=[0.3], width=50, height=40)
     good = mirrored(s)
     bad = replace(good, pellet_orientation=np.pi - s.pellet_orientation)
-    a = permuted(sense(s, cfg, return_raw=True), cfg)
-    np.testing.assert_allclose(sense(good, cfg)["ampullary"], a["ampullary"], atol=1e-9)
+    a = permuted(sense(s, cfg, return_raw=True, tolerance=0), cfg)
+    np.testing.assert_allclose(sense(good, cfg, tolerance=0)["ampullary"], a["ampullary"], atol=1e-9)
     assert not np.allclose(sense(bad, cfg)["ampullary"], a["ampullary"], atol=1e-3)
 
 
+@pytest.mark.parametrize("tolerance", TOLERANCES)
 @pytest.mark.parametrize("seed", [0, 1, 2])
 @pytest.mark.parametrize("beta", [0.7, np.pi / 2, 2.9, -2.0])
-def test_rotated_scene_gives_identical_readings_without_walls(seed, beta):
+def test_rotated_scene_gives_identical_readings_without_walls(seed, beta, tolerance):
     cfg = cfg_with("physics.image_order=0")
     s = disk_scene(seed, 4, 80)
-    a = sense(s, cfg, return_raw=True)
-    b = sense(rotated(s, beta), cfg, return_raw=True)
+    a = sense(s, cfg, return_raw=True, tolerance=tolerance)
+    b = sense(rotated(s, beta), cfg, return_raw=True, tolerance=tolerance)
     assert np.any(a["mormyromast"] != 0) and np.any(a["ampullary"] != 0)
-    assert_same_readings(a, b, ranges(cfg))
+    assert_same_readings(a, b, ranges(cfg), tolerance)
 
 
+@pytest.mark.parametrize("tolerance", TOLERANCES)
 @pytest.mark.parametrize("order", [1, 2])
-def test_quarter_turn_in_a_square_arena_keeps_the_readings_with_walls(order):
+def test_quarter_turn_in_a_square_arena_keeps_the_readings_with_walls(order, tolerance):
     cfg = cfg_with(f"physics.image_order={order}", "sensors.mormyromast.wall_distortion=true")
     s = random_snapshot(np.random.default_rng(5), 3, 50, width=40.0, height=40.0)
-    a = sense(s, cfg, return_raw=True)
-    b = sense(rotated(s, np.pi / 2), cfg, return_raw=True)
-    assert_same_readings(a, b, ranges(cfg))
+    a = sense(s, cfg, return_raw=True, tolerance=tolerance)
+    b = sense(rotated(s, np.pi / 2), cfg, return_raw=True, tolerance=tolerance)
+    assert_same_readings(a, b, ranges(cfg), tolerance)
 
 
 def test_walls_break_rotation_symmetry():
@@ -169,7 +180,8 @@ def test_translation_without_walls_keeps_the_readings():
     s = random_snapshot(np.random.default_rng(8), 3, 40, width=60.0, height=60.0)
     moved = replace(s, agent_xy=s.agent_xy + [25.0, 13.0], pellet_xy=s.pellet_xy + [25.0, 13.0],
                     width=100.0, height=100.0)
-    assert_same_readings(sense(s, cfg, return_raw=True), sense(moved, cfg, return_raw=True), ranges(cfg))
+    assert_same_readings(sense(s, cfg, return_raw=True, tolerance=0), sense(moved, cfg, return_raw=True, tolerance=0),
+                         ranges(cfg))
 
 
 def test_relabelling_agents_permutes_readings_and_slots():
@@ -178,7 +190,7 @@ def test_relabelling_agents_permutes_readings_and_slots():
     order = np.array([2, 0, 3, 1])
     t = replace(s, agent_xy=s.agent_xy[order], agent_heading=s.agent_heading[order],
                 agent_size=s.agent_size[order], agent_emitting=s.agent_emitting[order])
-    a, b = sense(s, cfg), sense(t, cfg)
+    a, b = sense(s, cfg, tolerance=0), sense(t, cfg, tolerance=0)
     np.testing.assert_allclose(b["mormyromast"], a["mormyromast"][order], atol=1e-9)
     np.testing.assert_allclose(b["ampullary"], a["ampullary"][order], atol=1e-9)
     n = len(order)

@@ -29,6 +29,9 @@ def kernel_constants(plan: EffectPlan) -> tuple[np.ndarray, np.ndarray]:
     c[kn.ONE], c[kn.TWO], c[kn.THREE], c[kn.ZERO] = 1.0, 2.0, 3.0, 0.0
     # log2(r / D) above this: the source is too close to interpolate
     c[kn.FAR_MAX_LX] = np.log2(plan.sensor_radius / plan.far_min) if plan.far_levels else -np.inf
+    # Interpolated sources are evaluated in float32: keep its round-off (~eps * bound) at or
+    # below the threshold, i.e. bound / threshold <= 1 / eps; stronger sources stay exact.
+    c[kn.FAR_MAX_LS] = np.log2(1.0 / np.finfo(np.float32).eps)
     f = np.zeros(kn.N_FLAGS, dtype=np.int64)
     f[kn.DO_MORM] = plan.on("mormyromast") and (plan.on("induction") or plan.on("wall_distortion"))
     f[kn.DO_AMP] = plan.on("ampullary") and plan.on("intrinsic_fields")

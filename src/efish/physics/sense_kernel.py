@@ -24,7 +24,7 @@ from numba import njit
 
 from .kernels import (
     _FASTMATH, ALPHA_AGENT, ALPHA_PELLET, CULL, DO_AMP, DO_INDUCTION, DO_KNOLL, DO_MORM, DO_PELLETS,
-    DO_WALLDIST, FAR_MAX_LX, G_CONS, G_SELF, HALF_SEP, K, K_CONS, KNOLL_ZERO, M1X, M1Y, M2X, M2Y, N_SRC, ONE,
+    DO_WALLDIST, FAR_MAX_LS, FAR_MAX_LX, G_CONS, G_SELF, HALF_SEP, K, K_CONS, KNOLL_ZERO, M1X, M1Y, M2X, M2Y, N_SRC, ONE,
     P_AGENT, P_PELLET, Q, R_SENS, SOFT2, SX, SY, TOL_AMP, TOL_MORM, ZERO, ZERO_AMP, ZERO_MORM,
     add_dipole, add_monopole, far_readings, image_table, induced_dipoles, place_sensors,
 )
@@ -73,7 +73,9 @@ def interpolation_levels(n_img, body_log_sig, geo, level_lcq, level_e, c, out):
     (from ``geo`` row 5), so the choice errs towards accuracy. The bound falls
     with the level, so the bucket is 1 + the number of failing levels, or 0
     (exact) when every level fails or the source is closer than the far-field
-    minimum. Written as counts over levels, branch-free, so it vectorises.
+    minimum, or so strong (bound / threshold > 2^FAR_MAX_LS) that float32, in
+    which interpolated sources are evaluated, would round off more than the
+    threshold. Written as counts over levels, branch-free, so it vectorises.
     """
     nb, n_lv = body_log_sig.shape[0], level_e.shape[0]
     n = nb * n_img
@@ -90,7 +92,19 @@ def interpolation_levels(n_img, body_log_sig, geo, level_lcq, level_e, c, out):
         for k in range(n):
             out[k] += lcq + ls[k] + e * lx[k] > 0
     for k in range(n):
-        out[k] = 0 if (out[k] == n_lv or lx[k] > c[FAR_MAX_LX]) else out[k] + 1
+        exact = out[k] == n_lv or lx[k] > c[FAR_MAX_LX] or ls[k] > c[FAR_MAX_LS]
+        out[k] = 0 if exact else out[k] + 1
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def to_float32_relative(src, count, ax, ay, out):
+    """Copy ``src[:, :count]`` to float32 with positions relative to (ax, ay), where float32 is precise."""
+    for i in range(count):
+        out[SX, i] = src[SX, i] - ax
+        out[SY, i] = src[SY, i] - ay
+    for row in range(M1X, N_SRC):
+        for i in range(count):
+            out[row, i] = src[row, i]
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
@@ -233,12 +247,15 @@ def interpolate_add(out, matrix_t, values):
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def sense_agent(a, axy, heading, emitting, bx, by, m1x, m1y, m2x, m2y, img, c, flags, tables, levels,
-                level_lcq, level_e, far_tables, interp_m, interp_a, geo, level, src, counts, scratch, out_m, out_a):
+def sense_agent(a, axy, heading, emitting, bx, by, m1x, m1y, m2x, m2y, img, c, c32, flags, tables, levels,
+                level_lcq, level_e, far_tables, interp_m, interp_a, geo, level, src, far, counts, scratch, scratch32,
+                out_m, out_a):
     """Mormyromast and Ampullary raw readings of agent ``a``.
 
     ``tables`` rows 0-1 / 2-3: cos, sin of Mormyromast / Ampullary angles.
-    ``scratch`` rows 0-3: sensor x, y, nx, ny; rows 4-5: readings at level points.
+    ``scratch`` rows 0-3: sensor x, y, nx, ny; rows 4-5: readings at level points
+    (``scratch32``: the same in float32 for the interpolated sources, ``c32``
+    the constants in float32).
     """
     sm, sa = out_m.shape[0], out_a.shape[0]
     ax, ay = axy[a, 0], axy[a, 1]
@@ -262,9 +279,15 @@ def sense_agent(a, axy, heading, emitting, bx, by, m1x, m1y, m2x, m2y, img, c, f
         nq = levels[lv]
         if counts[lv + 1] == 0 or not (do_m or do_a):
             continue
-        place_sensors(ax, ay, heading[a], far_tables[lv, 0, :nq], far_tables[lv, 1, :nq], c[R_SENS],
-                      sx[:nq], sy[:nq], nx[:nq], ny[:nq])
-        far_readings(src[lv + 1], counts[lv + 1], sx[:nq], sy[:nq], nx[:nq], ny[:nq], c, scratch[4, :nq], scratch[5, :nq])
+        px, py, pnx, pny = scratch32[0, :nq], scratch32[1, :nq], scratch32[2, :nq], scratch32[3, :nq]
+        place_sensors(0.0, 0.0, heading[a], far_tables[lv, 0, :nq], far_tables[lv, 1, :nq], c32[R_SENS],
+                      px, py, pnx, pny)
+        # interpolated sources are evaluated in float32 (twice the SIMD width, far cheaper
+        # sqrt and division); positions relative to the agent keep it precise
+        to_float32_relative(src[lv + 1], counts[lv + 1], ax, ay, far)
+        far_readings(far, counts[lv + 1], px, py, pnx, pny, c32, scratch32[4, :nq], scratch32[5, :nq])
+        scratch[4, :nq] = scratch32[4, :nq]
+        scratch[5, :nq] = scratch32[5, :nq]
         if do_m:
             interpolate_add(out_m, interp_m[lv, :nq], scratch[4, :nq])
         if do_a:
@@ -284,10 +307,13 @@ def sense_batch_kernel(agent_xy, heading, emitting, pellet_xy, pellet_phi, pelle
     nb_max = n + (pellet_xy.shape[1] if flags[DO_PELLETS] else 0)
     cap = nb_max * img_idx.shape[0]
     src = np.empty((levels.shape[0] + 1, N_SRC, cap), c.dtype)
+    far = np.empty((N_SRC, cap), np.float32)
+    c32 = c.astype(np.float32)
     counts = np.zeros(levels.shape[0] + 1, np.int64)
     geo = np.empty((6, cap), np.float64)
     level = np.zeros(cap, np.int64)
     scratch = np.empty((6, max(tables.shape[1], far_tables.shape[2])), c.dtype)
+    scratch32 = np.empty((6, far_tables.shape[2]), np.float32)
     p_ind = np.zeros((n, 2, nb_max), c.dtype)  # per emitter: induced moments of every body
     body = np.empty((7, nb_max), c.dtype)  # x, y, alpha, m1x, m1y, m2x, m2y
     for b in range(b_count):
@@ -318,7 +344,7 @@ def sense_batch_kernel(agent_xy, heading, emitting, pellet_xy, pellet_phi, pelle
                 body[3, :nb] = c[ZERO]
                 body[4, :nb] = c[ZERO]
             sense_agent(a, agent_xy[b], heading[b], emitting[b], body[0, :nb], body[1, :nb], body[3, :nb],
-                        body[4, :nb], body[5, :nb], body[6, :nb], img, c, flags, tables, levels, level_lcq, level_e, far_tables,
-                        interp_m, interp_a, geo, level, src, counts, scratch, out_m[b, a], out_a[b, a])
+                        body[4, :nb], body[5, :nb], body[6, :nb], img, c, c32, flags, tables, levels, level_lcq, level_e, far_tables,
+                        interp_m, interp_a, geo, level, src, far, counts, scratch, scratch32, out_m[b, a], out_a[b, a])
         if flags[DO_KNOLL]:
             knollenorgan_env(agent_xy[b], heading[b], emitting[b], cos_k, sin_k, c, flags, out_k[b])
