@@ -109,14 +109,15 @@ def to_float32_relative(src, count, ax, ay, out):
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
 def gather_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, img, c, thr1, thr2, level_lcq, level_e,
-                   geo, level, src, counts):
+                   geo, level, keep, src, counts):
     """Images of body moments whose bound at agent ``a`` reaches a threshold, bucketed by level.
 
     Column 1 (Mormyromast) and column 2 (Ampullary) are culled separately; a
     culled column is stored as 0. The agent's own intrinsic dipole enters only
     through its images. ``src[level, :, :counts[level]]`` receives the sources.
     ``geo`` rows 4-5 receive upper bounds of log2(bound) and log2(D^2), ``level``
-    the bucket of every source. Returns the bound sums of both columns.
+    the bucket of every source, ``keep`` which columns survive culling. Returns
+    the bound sums of both columns.
     """
     nb, n_img = bx.shape[0], img.shape[0]
     image_bounds(ax, ay, bx, by, img, c[R_SENS], geo)
@@ -132,31 +133,39 @@ def gather_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, img, c, thr1, thr2, le
             body[j] = max(m1x[j] * m1x[j] + m1y[j] * m1y[j], 0.0) * inv1 * inv1
             body[j] = 0.5 * math.log2(max(body[j], (m2x[j] * m2x[j] + m2y[j] * m2y[j]) * inv2 * inv2, 1e-300))
         interpolation_levels(n_img, body, geo, level_lcq, level_e, c, level)
-    counts[:] = 0
-    total1 = total2 = 0.0  # bounds steer decisions only: float64 whatever the dtype
+    # cull, branch-free so it vectorises: keep[k] bit 1 = Mormyromast column, bit 2 = Ampullary
+    mag1, mag2 = np.empty(nb), np.empty(nb)
     for j in range(nb):
-        mag1 = np.sqrt(m1x[j] * m1x[j] + m1y[j] * m1y[j])
-        mag2 = np.sqrt(m2x[j] * m2x[j] + m2y[j] * m2y[j])
-        if mag1 == 0 and mag2 == 0:
-            continue
-        for i in range(n_img):
+        mag1[j] = np.sqrt(m1x[j] * m1x[j] + m1y[j] * m1y[j])
+        mag2[j] = np.sqrt(m2x[j] * m2x[j] + m2y[j] * m2y[j])
+    # the agent's own intrinsic dipole enters through its images only (its own induced
+    # moment is already 0): drop the identity image, whose bound is huge (it sits on the body)
+    geo[2, a] = 0.0
+    total1 = total2 = 0.0  # bounds steer decisions only: float64 whatever the dtype
+    for i in range(n_img):
+        for j in range(nb):
             k = i * nb + j
-            b1 = mag1 * geo[2, k]
-            b2 = mag2 * geo[2, k] if not (j == a and i == 0) else 0.0
+            b1 = mag1[j] * geo[2, k]
+            b2 = mag2[j] * geo[2, k]
             total1 += b1
             total2 += b2
-            keep1, keep2 = mag1 > 0 and b1 >= thr1, b2 > 0 and b2 >= thr2
-            if not (keep1 or keep2):
+            keep[k] = (mag1[j] > 0 and b1 >= thr1) * 1 + (mag2[j] > 0 and b2 >= thr2) * 2
+    keep[a] = 0
+    counts[:] = 0
+    for i in range(n_img):
+        w, sx, sy = img[i, 4], img[i, 1], img[i, 3]
+        for j in range(nb):
+            k = i * nb + j
+            if keep[k] == 0:
                 continue
             lv = level[k]
             q = counts[lv]
             counts[lv] += 1
-            w = img[i, 4]
             src[lv, SX, q], src[lv, SY, q] = geo[0, k], geo[1, k]
-            src[lv, M1X, q] = img[i, 1] * w * m1x[j] if keep1 else c[ZERO]
-            src[lv, M1Y, q] = img[i, 3] * w * m1y[j] if keep1 else c[ZERO]
-            src[lv, M2X, q] = img[i, 1] * w * m2x[j] if keep2 else c[ZERO]
-            src[lv, M2Y, q] = img[i, 3] * w * m2y[j] if keep2 else c[ZERO]
+            src[lv, M1X, q] = sx * w * m1x[j] if keep[k] & 1 else c[ZERO]
+            src[lv, M1Y, q] = sy * w * m1y[j] if keep[k] & 1 else c[ZERO]
+            src[lv, M2X, q] = sx * w * m2x[j] if keep[k] & 2 else c[ZERO]
+            src[lv, M2Y, q] = sy * w * m2y[j] if keep[k] & 2 else c[ZERO]
     return total1, total2
 
 
@@ -248,7 +257,7 @@ def interpolate_add(out, matrix_t, values):
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
 def sense_agent(a, axy, heading, emitting, bx, by, m1x, m1y, m2x, m2y, img, c, c32, flags, tables, levels,
-                level_lcq, level_e, far_tables, interp_m, interp_a, geo, level, src, far, counts, scratch, scratch32,
+                level_lcq, level_e, far_tables, interp_m, interp_a, geo, level, keep, src, far, counts, scratch, scratch32,
                 out_m, out_a):
     """Mormyromast and Ampullary raw readings of agent ``a``.
 
@@ -262,7 +271,7 @@ def sense_agent(a, axy, heading, emitting, bx, by, m1x, m1y, m2x, m2y, img, c, c
     thr1 = c[TOL_MORM] if flags[CULL] else -1.0
     thr2 = c[TOL_AMP] if flags[CULL] else -1.0
     tot1, tot2 = gather_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, img, c, thr1, thr2, level_lcq, level_e,
-                                geo, level, src, counts)
+                                geo, level, keep, src, counts)
     walls = flags[DO_WALLDIST] and emitting[a] and img.shape[0] > 1 and c[G_SELF] != 0
     do_m = flags[DO_MORM] and (walls or not flags[CULL] or tot1 > c[ZERO_MORM])
     do_a = flags[DO_AMP] and (not flags[CULL] or tot2 > c[ZERO_AMP])
@@ -312,6 +321,7 @@ def sense_batch_kernel(agent_xy, heading, emitting, pellet_xy, pellet_phi, pelle
     counts = np.zeros(levels.shape[0] + 1, np.int64)
     geo = np.empty((6, cap), np.float64)
     level = np.zeros(cap, np.int64)
+    keep = np.zeros(cap, np.int64)
     scratch = np.empty((6, max(tables.shape[1], far_tables.shape[2])), c.dtype)
     scratch32 = np.empty((6, far_tables.shape[2]), np.float32)
     p_ind = np.zeros((n, 2, nb_max), c.dtype)  # per emitter: induced moments of every body
@@ -345,6 +355,6 @@ def sense_batch_kernel(agent_xy, heading, emitting, pellet_xy, pellet_phi, pelle
                 body[4, :nb] = c[ZERO]
             sense_agent(a, agent_xy[b], heading[b], emitting[b], body[0, :nb], body[1, :nb], body[3, :nb],
                         body[4, :nb], body[5, :nb], body[6, :nb], img, c, c32, flags, tables, levels, level_lcq, level_e, far_tables,
-                        interp_m, interp_a, geo, level, src, far, counts, scratch, scratch32, out_m[b, a], out_a[b, a])
+                        interp_m, interp_a, geo, level, keep, src, far, counts, scratch, scratch32, out_m[b, a], out_a[b, a])
         if flags[DO_KNOLL]:
             knollenorgan_env(agent_xy[b], heading[b], emitting[b], cos_k, sin_k, c, flags, out_k[b])
