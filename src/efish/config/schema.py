@@ -119,19 +119,37 @@ class SensorsConfig:
 # ----------------------------------------------------------------------- arena
 @dataclass
 class ArenaConfig:
-    """Arena size and food layout (SPEC 8)."""
+    """Arena size and food layout (SPEC 8). ``layout=training`` samples size, layout and
+    food multiplier per episode from the ``train_*`` fields."""
 
-    layout: str = param("patchy", "food layout", choices=("patchy", "uniform", "none"))
+    layout: str = param("patchy", "food layout",
+                        choices=("patchy", "uniform", "npatch", "onepatch", "training", "none"))
     width_cm: float = param(70.0, "arena width, cm", lo=4.0, hi=10000.0)
     height_cm: float = param(70.0, "arena height, cm", lo=4.0, hi=10000.0)
-    food_multiplier: float = param(1.0, "scales every food density (patch count for patchy)", lo=0.0, hi=100.0)
+    food_multiplier: float = param(1.0, "scales food: uniform density, patchy patch count, npatch pellets", lo=0.0, hi=100.0)
     uniform_density: float = param(0.0045, "uniform: Poisson mean pellets per cm^2", lo=0.0)
     uniform_cap_density: float = param(0.005, "uniform: at most round(this * area) pellets", lo=0.0)
-    patch_density: float = param(0.001, "patchy: ceil(this * area * multiplier) patches, at least 1", lo=0.0)
+    patch_density: float = param(0.001, "patchy: max(1, round(multiplier * ceil(this * area))) patches", lo=0.0)
     patch_radius_mean_cm: float = param(6.0, "patchy: patch radius mean, cm", lo=0.0)
     patch_radius_sd_cm: float = param(1.5, "patchy: patch radius sd, cm", lo=0.0)
-    patch_pellet_density: float = param(0.15, "patchy: Poisson mean pellets per cm^2 of a patch", lo=0.0)
+    patch_radius_min_cm: float = param(1.0, "patchy: patch radius lower clip, cm (upper: min(W, H) / 2)", lo=0.0)
+    patch_pellet_density: float = param(0.15, "patchy and npatch: Poisson mean pellets per cm^2 of a patch", lo=0.0)
     patch_cap_density: float = param(0.2, "patchy: at most round(this * pi r^2) pellets per patch", lo=0.0)
+    npatch_count: int = param(1, "npatch: number of patches n", lo=1, hi=64)
+    npatch_radius_cm: float = param(7.5, "npatch: patch radius, cm", lo=0.0)
+    npatch_ring_fraction: float = param(0.75, "npatch: ellipse semi-axes as a fraction of W/2 and H/2", lo=0.0, hi=1.0)
+    onepatch_radius_cm: float = param(6.0, "onepatch: radius of the central patch, cm", lo=0.0)
+    onepatch_initial_mean: float = param(11.3, "onepatch: Poisson mean pellets at the start", lo=0.0)
+    onepatch_regrow_mean: float = param(1.13, "onepatch: Poisson mean pellets regrown per step", lo=0.0)
+    onepatch_cap: int = param(34, "onepatch: regrowth stops at this many pellets", lo=0)
+    train_size_min_cm: float = param(40.0, "training: W, H = min + span * u^exponent, u ~ U(0, 1)", lo=4.0)
+    train_size_span_cm: float = param(260.0, "training: see train_size_min_cm", lo=0.0)
+    train_size_exponent: float = param(3.0, "training: see train_size_min_cm", lo=0.0)
+    train_patchy_weight: float = param(5.0, "training: odds of patchy against uniform, patchy part", lo=0.0)
+    train_uniform_weight: float = param(1.0, "training: odds of patchy against uniform, uniform part", lo=0.0)
+    train_multiplier_min: float = param(0.5, "training: food multiplier log-uniform in [min, max]", lo=0.0)
+    train_multiplier_max: float = param(2.0, "training: see train_multiplier_min", lo=0.0)
+    orientation_drift_rad: float = param(0.1, "pellet orientation random walk, sd per step, rad", lo=0.0)
     wall_margin_cm: float = param(1.0, "agents spawn at least this far from walls, cm", lo=0.0)
 
 
@@ -205,6 +223,11 @@ def validate(obj: Any, path: str = "") -> None:
 
 def _check_consistency(obj: Any, path: str) -> None:
     """Cross-field rules that a single range cannot express."""
+    if isinstance(obj, ArenaConfig):
+        if obj.train_multiplier_min > obj.train_multiplier_max or obj.train_multiplier_min <= 0:
+            raise ConfigError(f"{path}train_multiplier_min must be > 0 and <= {path}train_multiplier_max")
+        if obj.train_patchy_weight + obj.train_uniform_weight <= 0:
+            raise ConfigError(f"{path}train_patchy_weight + {path}train_uniform_weight must be > 0")
     if isinstance(obj, PhysicsConfig):
         levels = list(obj.far_field_levels)
         if any(q % 2 == 0 or not 3 <= q <= 63 for q in levels) or levels != sorted(set(levels)):

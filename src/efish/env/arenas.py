@@ -1,6 +1,12 @@
-"""Food layouts and spawn positions (SPEC 6 reset, SPEC 8)."""
+"""Arenas and food: layouts, per-episode sampling, regrowth and drift (SPEC 6 reset, SPEC 8).
+
+Every function takes the arena config and a ``numpy.random.Generator``; none
+keeps state. Positions are in cm, angles in radians.
+"""
 
 from __future__ import annotations
+
+import dataclasses
 
 import numpy as np
 
@@ -9,29 +15,88 @@ from ..config.schema import ArenaConfig
 AGENT_RADIUS_CM = 1.0  # bodies are 1 cm circles (SPEC 1); non-overlap means centres >= 2 cm apart
 
 
+def sample_arena(cfg: ArenaConfig, rng: np.random.Generator) -> ArenaConfig:
+    """The arena of one episode: ``cfg`` itself, or for ``layout=training`` a sampled one.
+
+    Training: W, H each min + span * u^exponent (u ~ U(0, 1)); patchy or uniform
+    with odds patchy_weight : uniform_weight; food multiplier log-uniform.
+    """
+    if cfg.layout != "training":
+        return cfg
+    w, h = cfg.train_size_min_cm + cfg.train_size_span_cm * rng.uniform(size=2) ** cfg.train_size_exponent
+    p_patchy = cfg.train_patchy_weight / (cfg.train_patchy_weight + cfg.train_uniform_weight)
+    layout = "patchy" if rng.uniform() < p_patchy else "uniform"
+    m = np.exp(rng.uniform(np.log(cfg.train_multiplier_min), np.log(cfg.train_multiplier_max)))
+    return dataclasses.replace(cfg, layout=layout, width_cm=float(w), height_cm=float(h), food_multiplier=float(m))
+
+
+def patch_count(cfg: ArenaConfig) -> int:
+    """Patches of the patchy layout: max(1, round(m * ceil(density * area))).
+
+    70 x 70: m = 1 -> 5, 0.5 -> 2, 0.25 -> 1 (SPEC 8; round half to even).
+    """
+    base = int(np.ceil(cfg.patch_density * cfg.width_cm * cfg.height_cm))
+    return max(1, int(round(cfg.food_multiplier * base)))
+
+
+def npatch_centres(cfg: ArenaConfig, rng: np.random.Generator) -> np.ndarray:
+    """Centres (n, 2) of the N-patch layout: the arena centre for n = 1, else evenly on an
+    ellipse of semi-axes ring_fraction * (W/2, H/2) from a random start angle."""
+    n = cfg.npatch_count
+    centre = np.array([cfg.width_cm, cfg.height_cm]) / 2
+    if n == 1:
+        return centre[None, :]
+    angles = rng.uniform(0, 2 * np.pi) + 2 * np.pi * np.arange(n) / n
+    semi = cfg.npatch_ring_fraction * centre
+    return centre + semi * np.stack([np.cos(angles), np.sin(angles)], axis=1)
+
+
 def sample_pellets(cfg: ArenaConfig, rng: np.random.Generator) -> np.ndarray:
-    """Pellet positions (P, 2) in cm for one episode of the arena's layout."""
-    w, h = cfg.width_cm, cfg.height_cm
+    """Pellet positions (P, 2) in cm at the start of an episode of the arena's layout."""
+    w, h, m = cfg.width_cm, cfg.height_cm, cfg.food_multiplier
     area = w * h
-    m = cfg.food_multiplier
+    if cfg.layout == "training":
+        raise ValueError("arena.layout=training must be resolved with sample_arena() first")
     if cfg.layout == "none":
         return np.zeros((0, 2))
     if cfg.layout == "uniform":
         count = min(rng.poisson(cfg.uniform_density * m * area), round(cfg.uniform_cap_density * m * area))
         return rng.uniform((0.0, 0.0), (w, h), size=(count, 2))
-    n_patches = max(1, int(np.ceil(cfg.patch_density * area * m)))
+    if cfg.layout == "onepatch":
+        centre = np.array([w, h]) / 2
+        count = min(rng.poisson(cfg.onepatch_initial_mean), cfg.onepatch_cap)
+        return points_in_disc(centre, cfg.onepatch_radius_cm, count, w, h, rng)
+    if cfg.layout == "npatch":
+        r = cfg.npatch_radius_cm
+        mean = cfg.patch_pellet_density * m * np.pi * r ** 2
+        return _concat([points_in_disc(c, r, rng.poisson(mean), w, h, rng) for c in npatch_centres(cfg, rng)])
     pellets = []
-    for _ in range(n_patches):
+    for _ in range(patch_count(cfg)):
         centre = rng.uniform((0.0, 0.0), (w, h))
-        radius = float(np.clip(rng.normal(cfg.patch_radius_mean_cm, cfg.patch_radius_sd_cm), 1.0, min(w, h) / 2))
+        radius = float(np.clip(rng.normal(cfg.patch_radius_mean_cm, cfg.patch_radius_sd_cm),
+                               cfg.patch_radius_min_cm, min(w, h) / 2))
         disc = np.pi * radius ** 2
         count = min(rng.poisson(cfg.patch_pellet_density * disc), round(cfg.patch_cap_density * disc))
-        pellets.append(_points_in_disc(centre, radius, count, w, h, rng))
-    return np.concatenate(pellets) if pellets else np.zeros((0, 2))
+        pellets.append(points_in_disc(centre, radius, count, w, h, rng))
+    return _concat(pellets)
 
 
-def _points_in_disc(centre: np.ndarray, radius: float, count: int, w: float, h: float,
-                    rng: np.random.Generator) -> np.ndarray:
+def regrow_onepatch(cfg: ArenaConfig, n_alive: int, rng: np.random.Generator) -> np.ndarray:
+    """New pellets (k, 2) of one step of one-patch regrowth: Poisson(regrow_mean), never above the cap."""
+    if cfg.layout != "onepatch":
+        return np.zeros((0, 2))
+    count = min(rng.poisson(cfg.onepatch_regrow_mean), max(0, cfg.onepatch_cap - n_alive))
+    centre = np.array([cfg.width_cm, cfg.height_cm]) / 2
+    return points_in_disc(centre, cfg.onepatch_radius_cm, count, cfg.width_cm, cfg.height_cm, rng)
+
+
+def drift_orientations(phi: np.ndarray, cfg: ArenaConfig, rng: np.random.Generator) -> np.ndarray:
+    """Pellet orientations after one step of drift N(0, sd), wrapped to [0, 2 pi)."""
+    return np.mod(phi + rng.normal(0.0, cfg.orientation_drift_rad, np.shape(phi)), 2 * np.pi)
+
+
+def points_in_disc(centre: np.ndarray, radius: float, count: int, w: float, h: float,
+                   rng: np.random.Generator) -> np.ndarray:
     """``count`` points uniform in the part of the disc that lies inside the arena (rejection)."""
     out = np.zeros((0, 2))
     while len(out) < count:
@@ -41,6 +106,10 @@ def _points_in_disc(centre: np.ndarray, radius: float, count: int, w: float, h: 
         inside = (p[:, 0] >= 0) & (p[:, 0] <= w) & (p[:, 1] >= 0) & (p[:, 1] <= h)
         out = np.concatenate([out, p[inside]])
     return out[:count]
+
+
+def _concat(parts: list[np.ndarray]) -> np.ndarray:
+    return np.concatenate(parts) if parts else np.zeros((0, 2))
 
 
 def spawn_agents(n: int, width: float, height: float, margin: float, rng: np.random.Generator,
