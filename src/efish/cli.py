@@ -4,6 +4,7 @@
     efish plan [overrides]                    which effects run, and why
     efish bench physics [overrides] [--json]  sensing throughput, fast vs reference
     efish bench accuracy [overrides] --out D  accuracy-vs-time study -> table + figure
+    efish bench env [overrides] [--json]      env-only throughput, fast vs reference physics
 
 Overrides are Hydra's ``key=value`` (``physics.image_order=2``) or group
 choices (``arena=patchy70``). Every error is one line on stderr, exit code 2,
@@ -36,6 +37,11 @@ def _parser() -> argparse.ArgumentParser:
     bp.add_argument("overrides", nargs="*")
     bp.add_argument("--json", action="store_true", help="print JSON instead of a table")
     bp.add_argument("--out", type=Path, help="also write bench_physics.json (+ config, provenance) here")
+    be = bsub.add_parser("env", help="env-only throughput with random actions: fast path vs reference")
+    be.add_argument("overrides", nargs="*")
+    be.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    be.add_argument("--envs", type=int, default=16, help="arenas stepped together (default 16)")
+    be.add_argument("--steps", type=int, default=100, help="timed steps (default 100)")
     ba = bsub.add_parser("accuracy", help="accuracy-vs-time sweep: table and figure")
     ba.add_argument("overrides", nargs="*")
     ba.add_argument("--out", type=Path, default=Path("results/bench"), help="output folder (default results/bench)")
@@ -103,6 +109,11 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(build_plan(cfg).explain())
         elif args.bench == "physics":
             _bench_physics(args, cfg, started)
+        elif args.bench == "env":
+            from .bench.env import bench_env, format_env
+
+            rows = bench_env(cfg, num_envs=args.envs, steps=args.steps)
+            print(json.dumps(rows, indent=2) if args.json else format_env(rows))
         else:
             _bench_accuracy(args, cfg, started)
     except (ConfigError, ValueError, OSError) as exc:

@@ -153,6 +153,39 @@ class ArenaConfig:
     wall_margin_cm: float = param(1.0, "agents spawn at least this far from walls, cm", lo=0.0)
 
 
+# ------------------------------------------------------------------------- env
+@dataclass
+class EnvConfig:
+    """Bodies, motion, eating, biting, rewards and interventions of the foraging task (SPEC 1, 4-7)."""
+
+    n_agents: int = param(4, "agents per environment", lo=1, hi=16)
+    obs_agents: int = param(4, "observation layout is sized for this many agents (unused slots are 0)", lo=1, hi=16)
+    episode_steps: int = param(1600, "steps before truncation", lo=1)
+    fps: float = param(83.0, "steps per second (dt = 1/fps)", lo=1.0)
+    speed_m_s: float = param(0.35, "v_max = speed * speed_gain * (1 + size), m/s", lo=0.0)
+    speed_gain: float = param(2.0, "see speed_m_s", lo=0.0)
+    turn_rad_s: float = param(3.6, "w_max = turn * turn_gain * (1 + size), rad/s", lo=0.0)
+    turn_gain: float = param(4.0, "see turn_rad_s", lo=0.0)
+    body_radius_cm: float = param(1.0, "agent radius; centres stay 2 radii apart, 1 radius from walls", lo=0.0)
+    eat_radius_cm: float = param(2.0, "a pellet centre this close and within the eat angle is eaten", lo=0.0)
+    eat_half_angle_deg: float = param(22.5, "eat zone: +-this from the heading, degrees", lo=0.0, hi=180.0)
+    bite_radius_cm: float = param(3.0, "another agent this close and within the bite angle is bitten", lo=0.0)
+    bite_half_angle_deg: float = param(22.5, "bite zone: +-this from the heading, degrees", lo=0.0, hi=180.0)
+    eat_cooldown: int = param(3, "steps frozen after eating", lo=0)
+    bite_cooldown: int = param(5, "steps before the next bite", lo=0)
+    reward_food: float = param(10.0, "reward per pellet eaten")
+    reward_shaping: float = param(1.0, "times (d_prev - d) / perimeter, d = distance to the nearest pellet")
+    penalty_bitten: float = param(5.0, "bitten: -this * (1 + size_biter - size_victim)")
+    penalty_bite: float = param(0.001, "cost of a successful bite")
+    penalty_collision: float = param(0.5, "cost of a cancelled move")
+    penalty_effort: float = param(0.1, "times max(0, |move| - free) + max(0, |turn| - free)")
+    effort_free: float = param(0.5, "effort-free part of |move| and |turn|", lo=0.0)
+    muted: list = param([], "agent ids that never emit")
+    frozen: list = param([], "agent ids that never move or turn")
+    sizes: list = param([], "fixed sizes per agent; empty = U(0, 1) per episode")
+    starts: list = param([], "fixed starts per agent as [x_cm, y_cm, heading_rad]; empty = random")
+
+
 # ----------------------------------------------------------------------- scene
 @dataclass
 class SceneConfig:
@@ -192,6 +225,7 @@ class EfishConfig:
     physics: PhysicsConfig = group(PhysicsConfig)
     sensors: SensorsConfig = group(SensorsConfig)
     arena: ArenaConfig = group(ArenaConfig)
+    env: EnvConfig = group(EnvConfig)
     scene: SceneConfig = group(SceneConfig)
     bench: BenchConfig = group(BenchConfig)
     scale: ScaleConfig = group(ScaleConfig)
@@ -223,6 +257,17 @@ def validate(obj: Any, path: str = "") -> None:
 
 def _check_consistency(obj: Any, path: str) -> None:
     """Cross-field rules that a single range cannot express."""
+    if isinstance(obj, EnvConfig):
+        if obj.n_agents > obj.obs_agents:
+            raise ConfigError(f"{path}n_agents={obj.n_agents} exceeds {path}obs_agents={obj.obs_agents} (observation slots)")
+        for key in ("muted", "frozen"):
+            bad = [i for i in getattr(obj, key) if not (isinstance(i, int) and 0 <= i < obj.n_agents)]
+            if bad:
+                raise ConfigError(f"{path}{key} has agent ids {bad} outside 0..{obj.n_agents - 1}")
+        if obj.sizes and (len(obj.sizes) != obj.n_agents or any(not 0 <= v <= 1 for v in obj.sizes)):
+            raise ConfigError(f"{path}sizes must hold {obj.n_agents} values in [0, 1]")
+        if obj.starts and (len(obj.starts) != obj.n_agents or any(len(x) != 3 for x in obj.starts)):
+            raise ConfigError(f"{path}starts must hold {obj.n_agents} entries [x_cm, y_cm, heading_rad]")
     if isinstance(obj, ArenaConfig):
         if obj.train_multiplier_min > obj.train_multiplier_max or obj.train_multiplier_min <= 0:
             raise ConfigError(f"{path}train_multiplier_min must be > 0 and <= {path}train_multiplier_max")

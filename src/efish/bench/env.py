@@ -1,0 +1,66 @@
+"""``efish bench env``: env-only throughput with random actions, fast physics vs reference."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from ..config.schema import EfishConfig
+from ..env.vec_env import VecEnv
+from ..sensing import sense_batch
+from .timing import best_time
+
+SCENES = {"patchy70": "4-agent patchy 70x70", "onepatch": "2-agent one-patch 150x150"}
+
+
+def _random_actions(rng: np.random.Generator, b: int, n: int) -> np.ndarray:
+    return np.concatenate([rng.normal(size=(b, n, 2)), rng.integers(0, 2, (b, n, 2))], axis=-1)
+
+
+def time_env(cfg: EfishConfig, num_envs: int, steps: int, seed: int, reference: bool = False) -> float:
+    """Agent-steps per second of ``steps`` random-action steps of ``num_envs`` arenas (one thread)."""
+    env = VecEnv(cfg, num_envs=num_envs, seed=seed)
+    if reference:  # same env, sensing through the brute-force oracle
+        env._observe = lambda eod, env=env: _reference_observe(env, eod)
+    env.reset()
+    rng = np.random.default_rng(seed)
+    acts = [_random_actions(rng, num_envs, env.n) for _ in range(steps)]
+
+    def run():
+        for a in acts:
+            env.step(a)
+    seconds = best_time(run, repeats=1 if reference else 3)
+    return num_envs * env.n * steps / seconds
+
+
+def _reference_observe(env: VecEnv, eod: np.ndarray) -> np.ndarray:
+    from ..env.observe import build_observation
+
+    e = env.cfg.env
+    readings = sense_batch(env.snapshot(eod), env.plan, rng=env.noise_rng, reference=True)
+    return build_observation(readings, env.last_action, env.was_bitten, env.size, env.bite_cd, env.eat_cd,
+                             env.displacement, env.v_max(), e.eat_cooldown, e.bite_cooldown, e.obs_agents)
+
+
+def bench_env(cfg: EfishConfig, num_envs: int = 16, steps: int = 100, reference_steps: int = 3) -> list[dict]:
+    """Throughput rows for the benchmark scenes: fast path, reference, ratio."""
+    rows = []
+    for arena, label in SCENES.items():
+        from ..config import compose
+
+        scene = compose([f"arena={arena}", f"env.n_agents={4 if arena == 'patchy70' else 2}"])
+        scene = dataclasses.replace(scene, env=dataclasses.replace(scene.env, episode_steps=10**9))
+        fast = time_env(scene, num_envs, steps, seed=cfg.bench.seed)
+        ref = time_env(scene, num_envs, reference_steps, seed=cfg.bench.seed, reference=True)
+        rows.append({"scene": label, "num_envs": num_envs, "fast_agent_steps_per_s": fast,
+                     "reference_agent_steps_per_s": ref, "speedup": fast / ref})
+    return rows
+
+
+def format_env(rows: list[dict]) -> str:
+    """The rows as an aligned table."""
+    lines = [f"{'scene':<28}{'fast agent-steps/s':>20}{'reference':>12}{'speed-up':>10}"]
+    lines += [f"{r['scene']:<28}{r['fast_agent_steps_per_s']:>20,.0f}{r['reference_agent_steps_per_s']:>12,.0f}"
+              f"{r['speedup']:>9,.0f}x" for r in rows]
+    return "\n".join(lines)

@@ -1,0 +1,120 @@
+"""Numba kernels of one step of the bodies: eating, motion, bites (SPEC 5-6).
+
+Agents act in id order within an arena (eating and moving are sequential, as
+the SPEC's "per agent" step says); bites are resolved simultaneously after
+every agent has moved. Pure functions of arrays; (B, N) leading dimensions.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+# Indices into the ``p`` parameter array.
+EAT_R2, EAT_COS, BITE_R2, BITE_COS, MIN_SEP2, WALL, EAT_CD, BITE_CD, N_PARAMS = range(9)
+
+
+@njit(cache=True)
+def in_cone(dx, dy, heading, r2_max, cos_half):
+    """Squared distance of (dx, dy) if it lies within the cone (radius, +-half angle) of ``heading``, else inf."""
+    d2 = dx * dx + dy * dy
+    if d2 > r2_max:
+        return np.inf
+    if d2 == 0.0:
+        return 0.0
+    if (dx * np.cos(heading) + dy * np.sin(heading)) < cos_half * np.sqrt(d2):
+        return np.inf
+    return d2
+
+
+@njit(cache=True)
+def eat_and_move(xy, heading, eat_cd, bite_cd, move, turn, bite, v_max, w_max, pellet_xy, alive,
+                 width, height, p, ate, collided, can_bite):
+    """Eating and motion of every agent, in id order, for B arenas (updates arrays in place).
+
+    An agent frozen by its eat cooldown neither eats nor moves. Otherwise, unless
+    it bites, it eats the nearest live pellet in its eat zone; then it turns and
+    moves; a move that would bring two centres closer than the minimum separation
+    is cancelled (the turn is kept) and flags a collision; centres are clipped to
+    the walls. Counters count down here; ``can_bite`` reports who may bite.
+    """
+    b_count, n = xy.shape[0], xy.shape[1]
+    for b in range(b_count):
+        for i in range(n):
+            frozen = eat_cd[b, i] > 0
+            can_bite[b, i] = bite_cd[b, i] == 0
+            eat_cd[b, i] = max(eat_cd[b, i] - 1, 0)
+            bite_cd[b, i] = max(bite_cd[b, i] - 1, 0)
+            ate[b, i] = False
+            collided[b, i] = False
+            if frozen:
+                continue
+            if not bite[b, i]:
+                best, best_k = np.inf, -1
+                for k in range(pellet_xy.shape[1]):
+                    if alive[b, k]:
+                        d2 = in_cone(pellet_xy[b, k, 0] - xy[b, i, 0], pellet_xy[b, k, 1] - xy[b, i, 1],
+                                     heading[b, i], p[EAT_R2], p[EAT_COS])
+                        if d2 < best:
+                            best, best_k = d2, k
+                if best_k >= 0:
+                    alive[b, best_k] = False
+                    ate[b, i] = True
+                    eat_cd[b, i] = int(p[EAT_CD])
+            theta = heading[b, i] + turn[b, i] * w_max[b, i]
+            theta = (theta + np.pi) % (2 * np.pi) - np.pi
+            heading[b, i] = theta
+            step = move[b, i] * v_max[b, i]
+            x = min(max(xy[b, i, 0] + step * np.cos(theta), p[WALL]), width[b] - p[WALL])
+            y = min(max(xy[b, i, 1] + step * np.sin(theta), p[WALL]), height[b] - p[WALL])
+            blocked = False
+            for j in range(n):
+                if j != i and (x - xy[b, j, 0]) ** 2 + (y - xy[b, j, 1]) ** 2 < p[MIN_SEP2]:
+                    blocked = True
+            if blocked:
+                collided[b, i] = step > 0
+            else:
+                xy[b, i, 0], xy[b, i, 1] = x, y
+
+
+@njit(cache=True)
+def resolve_bites(xy, heading, size, bite, can_bite, bite_cd, p, bitten_by, bit, penalty_bitten):
+    """Simultaneous bites after motion: each willing, able agent bites the nearest agent in its bite zone.
+
+    Writes ``bit`` (bool[B, N]), ``bitten_by`` (int[B, N], how many bites each
+    received) and ``penalty_bitten`` (float[B, N], sum of 1 + s_biter - s_victim).
+    """
+    b_count, n = xy.shape[0], xy.shape[1]
+    for b in range(b_count):
+        for i in range(n):
+            bitten_by[b, i] = 0
+            penalty_bitten[b, i] = 0.0
+            bit[b, i] = False
+        for i in range(n):
+            if not (bite[b, i] and can_bite[b, i]):
+                continue
+            best, victim = np.inf, -1
+            for j in range(n):
+                if j != i:
+                    d2 = in_cone(xy[b, j, 0] - xy[b, i, 0], xy[b, j, 1] - xy[b, i, 1], heading[b, i],
+                                 p[BITE_R2], p[BITE_COS])
+                    if d2 < best:
+                        best, victim = d2, j
+            if victim >= 0:
+                bit[b, i] = True
+                bite_cd[b, i] = int(p[BITE_CD])
+                bitten_by[b, victim] += 1
+                penalty_bitten[b, victim] += 1.0 + size[b, i] - size[b, victim]
+
+
+@njit(cache=True)
+def nearest_pellet_distance(xy, pellet_xy, alive, out):
+    """Distance (cm) from each agent to its nearest live pellet; NaN when none is left."""
+    for b in range(xy.shape[0]):
+        for i in range(xy.shape[1]):
+            best = np.inf
+            for k in range(pellet_xy.shape[1]):
+                if alive[b, k]:
+                    d2 = (pellet_xy[b, k, 0] - xy[b, i, 0]) ** 2 + (pellet_xy[b, k, 1] - xy[b, i, 1]) ** 2
+                    best = min(best, d2)
+            out[b, i] = np.sqrt(best) if best < np.inf else np.nan

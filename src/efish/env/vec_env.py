@@ -1,0 +1,216 @@
+"""``VecEnv``: B foraging arenas stepped in one call (DESIGN "Environment API").
+
+State is struct-of-arrays with (env, agent) leading dimensions; the body
+kernels are in :mod:`efish.env.dynamics`, sensing in :mod:`efish.sensing`.
+One seed fixes food, spawn, sizes and noise: the root seed spawns one
+generator per arena (food, spawn, sizes) and one for sensor noise.
+
+    >>> from efish.config import compose
+    >>> env = VecEnv(compose(["env.episode_steps=5"]), num_envs=2, seed=0)
+    >>> obs = env.reset()
+    >>> obs.shape
+    (2, 4, 110)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..config.schema import EfishConfig
+from ..physics.plan import build_plan
+from ..physics.snapshot import SnapshotBatch
+from ..sensing import sense_batch
+from . import dynamics as dyn
+from .arenas import drift_orientations, regrow_onepatch, sample_arena, sample_pellets, spawn_agents
+from .observe import build_observation
+from .rewards import foraging_rewards
+
+
+def _sigmoid(x: np.ndarray) -> np.ndarray:
+    return 0.5 * (1.0 + np.tanh(0.5 * x))  # overflow-free logistic
+
+
+class VecEnv:
+    """B foraging environments with N agents each, stepped together.
+
+    ``reset() -> obs float32[B, N, D]``; ``step(actions float[B, N, 4])`` with
+    actions (a_move, a_turn, eod, bite): a_move and a_turn are raw Gaussian
+    samples mapped by sigmoid and tanh, eod and bite are 0/1. Returns
+    ``obs, reward[B, N], terminated[B], truncated[B], info``. Arenas that end
+    are reset in the same call; their last observation is in ``info["final_obs"]``.
+    """
+
+    def __init__(self, cfg: EfishConfig, num_envs: int, seed: int):
+        if num_envs < 1:
+            raise ValueError(f"num_envs must be >= 1, got {num_envs}")
+        self.cfg, self.num_envs, self.n = cfg, int(num_envs), cfg.env.n_agents
+        root = np.random.SeedSequence(seed)
+        children = root.spawn(num_envs + 1)
+        self.rngs = [np.random.default_rng(s) for s in children[:-1]]
+        self.noise_rng = np.random.default_rng(children[-1])
+        self.plan = build_plan(cfg, n_agents=self.n)
+        e = cfg.env
+        self.params = np.zeros(dyn.N_PARAMS)
+        self.params[dyn.EAT_R2], self.params[dyn.BITE_R2] = e.eat_radius_cm ** 2, e.bite_radius_cm ** 2
+        self.params[dyn.EAT_COS] = np.cos(np.radians(e.eat_half_angle_deg))
+        self.params[dyn.BITE_COS] = np.cos(np.radians(e.bite_half_angle_deg))
+        self.params[dyn.MIN_SEP2], self.params[dyn.WALL] = (2 * e.body_radius_cm) ** 2, e.body_radius_cm
+        self.params[dyn.EAT_CD], self.params[dyn.BITE_CD] = e.eat_cooldown, e.bite_cooldown
+        self.muted = np.isin(np.arange(self.n), e.muted)
+        self.frozen = np.isin(np.arange(self.n), e.frozen)
+        self._allocate(pellet_capacity=1)
+
+    # ------------------------------------------------------------------ state
+    def _allocate(self, pellet_capacity: int) -> None:
+        b, n = self.num_envs, self.n
+        self.xy = np.zeros((b, n, 2))                 # cm
+        self.heading = np.zeros((b, n))               # rad
+        self.size = np.zeros((b, n))                  # [0, 1]
+        self.eat_cd = np.zeros((b, n), np.int64)      # steps left
+        self.bite_cd = np.zeros((b, n), np.int64)
+        self.last_action = np.zeros((b, n, 4))        # move, turn, eod, bite after mapping
+        self.was_bitten = np.zeros((b, n), bool)
+        self.displacement = np.zeros((b, n, 2))       # last step, body frame, cm
+        self.d_food = np.full((b, n), np.nan)         # cm to the nearest pellet
+        self.width, self.height = np.zeros(b), np.zeros(b)
+        self.arena = [self.cfg.arena] * b
+        self.t = np.zeros(b, np.int64)
+        self._pellets(pellet_capacity)
+
+    def _pellets(self, capacity: int) -> None:
+        b = self.num_envs
+        self.pellet_xy = np.zeros((b, capacity, 2))
+        self.pellet_phi = np.zeros((b, capacity))
+        self.alive = np.zeros((b, capacity), bool)
+
+    def _grow_pellets(self, capacity: int) -> None:
+        if capacity <= self.pellet_xy.shape[1]:
+            return
+        old = (self.pellet_xy, self.pellet_phi, self.alive)
+        self._pellets(capacity)
+        k = old[0].shape[1]
+        self.pellet_xy[:, :k], self.pellet_phi[:, :k], self.alive[:, :k] = old
+
+    def _reset_env(self, b: int) -> None:
+        rng, e = self.rngs[b], self.cfg.env
+        arena = sample_arena(self.cfg.arena, rng)
+        self.arena[b] = arena
+        self.width[b], self.height[b] = arena.width_cm, arena.height_cm
+        pellets = sample_pellets(arena, rng)
+        cap = len(pellets) + (arena.onepatch_cap if arena.layout == "onepatch" else 0)
+        self._grow_pellets(max(cap, 1))
+        self.alive[b] = False
+        self.pellet_xy[b, : len(pellets)] = pellets
+        self.pellet_phi[b, : len(pellets)] = rng.uniform(0, 2 * np.pi, len(pellets))
+        self.alive[b, : len(pellets)] = True
+        if e.starts:
+            starts = np.asarray(e.starts, dtype=float)
+            r = e.body_radius_cm
+            if np.any(starts[:, :2] < r) or np.any(starts[:, :2] > [arena.width_cm - r, arena.height_cm - r]):
+                raise ValueError(f"env.starts has a position outside the {arena.width_cm:g} x {arena.height_cm:g} cm "
+                                 f"arena (less than {r:g} cm from a wall)")
+            self.xy[b], self.heading[b] = starts[:, :2], starts[:, 2]
+        else:
+            self.xy[b] = spawn_agents(self.n, arena.width_cm, arena.height_cm, arena.wall_margin_cm, rng)
+            self.heading[b] = rng.uniform(-np.pi, np.pi, self.n)
+        self.size[b] = e.sizes if e.sizes else rng.uniform(0, 1, self.n)
+        self.eat_cd[b] = self.bite_cd[b] = 0
+        self.last_action[b] = 0.0
+        self.was_bitten[b] = False
+        self.displacement[b] = 0.0
+        self.t[b] = 0
+
+    # ------------------------------------------------------------------- API
+    def reset(self) -> np.ndarray:
+        """Start a new episode in every arena; observations float32[B, N, D]."""
+        for b in range(self.num_envs):
+            self._reset_env(b)
+        dyn.nearest_pellet_distance(self.xy, self.pellet_xy, self.alive, self.d_food)
+        return self._observe(np.zeros((self.num_envs, self.n), bool))
+
+    def v_max(self) -> np.ndarray:
+        """Largest step per agent, cm (SPEC 5): speed * gain * (1 + size) / fps; 0 when frozen."""
+        e = self.cfg.env
+        v = e.speed_m_s * e.speed_gain * (1 + self.size) * 100.0 / e.fps
+        return np.where(self.frozen, 0.0, v)
+
+    def w_max(self) -> np.ndarray:
+        """Largest turn per agent, rad (SPEC 5); 0 when frozen."""
+        e = self.cfg.env
+        return np.where(self.frozen, 0.0, e.turn_rad_s * e.turn_gain * (1 + self.size) / e.fps)
+
+    def step(self, actions: np.ndarray):
+        """Advance every arena by one step (SPEC 6). See the class docstring."""
+        actions = np.asarray(actions, dtype=np.float64)
+        if actions.shape != (self.num_envs, self.n, 4):
+            raise ValueError(f"actions must have shape ({self.num_envs}, {self.n}, 4), got {actions.shape}")
+        if not np.all(np.isfinite(actions)):
+            raise ValueError("actions contain NaN or infinite values")
+        e = self.cfg.env
+        # 1. food dynamics
+        self._food_dynamics()
+        # 2. map actions, eat, move
+        move, turn = _sigmoid(actions[..., 0]), np.tanh(actions[..., 1])
+        eod = (actions[..., 2] > 0.5) & ~self.muted
+        bite = actions[..., 3] > 0.5
+        old_xy = self.xy.copy()
+        ate, collided, can_bite = (np.zeros((self.num_envs, self.n), bool) for _ in range(3))
+        dyn.eat_and_move(self.xy, self.heading, self.eat_cd, self.bite_cd, move, turn, bite, self.v_max(),
+                         self.w_max(), self.pellet_xy, self.alive, self.width, self.height, self.params,
+                         ate, collided, can_bite)
+        # 4. bites, simultaneously, on post-move positions (3. sensing happens in _observe)
+        bit, bitten_by = np.zeros_like(ate), np.zeros((self.num_envs, self.n), np.int64)
+        penalty = np.zeros((self.num_envs, self.n))
+        dyn.resolve_bites(self.xy, self.heading, self.size, bite, can_bite, self.bite_cd, self.params,
+                          bitten_by, bit, penalty)
+        # 5. rewards
+        d_prev = self.d_food.copy()
+        dyn.nearest_pellet_distance(self.xy, self.pellet_xy, self.alive, self.d_food)
+        rewards = foraging_rewards(e, ate, d_prev, self.d_food, 2 * (self.width + self.height), penalty, bit,
+                                   collided, move, turn)
+        # 6. observations
+        delta = self.xy - old_xy
+        c, s = np.cos(self.heading), np.sin(self.heading)
+        self.displacement = np.stack([c * delta[..., 0] + s * delta[..., 1], -s * delta[..., 0] + c * delta[..., 1]], -1)
+        self.last_action = np.stack([move, turn, eod, bite], axis=-1).astype(np.float64)
+        self.was_bitten = bitten_by > 0
+        info = {"ate": ate, "bit": bit, "was_bitten": self.was_bitten.copy(), "collided": collided, "eod": eod,
+                "reward_parts": rewards, "d_food_cm": self.d_food.copy()}
+        obs = self._observe(eod)
+        # 7. time limit: truncation, then same-step reset
+        self.t += 1
+        truncated = self.t >= e.episode_steps
+        terminated = np.zeros(self.num_envs, bool)
+        done = truncated | terminated
+        if done.any():
+            info["final_obs"] = obs.copy()
+            for b in np.flatnonzero(done):
+                self._reset_env(b)
+            dyn.nearest_pellet_distance(self.xy, self.pellet_xy, self.alive, self.d_food)
+            obs[done] = self._observe(np.zeros((self.num_envs, self.n), bool))[done]
+        return obs, rewards["total"], terminated, truncated, info
+
+    # --------------------------------------------------------------- helpers
+    def _food_dynamics(self) -> None:
+        for b in range(self.num_envs):
+            arena, rng = self.arena[b], self.rngs[b]
+            live = self.alive[b]
+            self.pellet_phi[b, live] = drift_orientations(self.pellet_phi[b, live], arena, rng)
+            new = regrow_onepatch(arena, int(live.sum()), rng)
+            if len(new):
+                free = np.flatnonzero(~self.alive[b])[: len(new)]
+                self.pellet_xy[b, free] = new[: len(free)]
+                self.pellet_phi[b, free] = rng.uniform(0, 2 * np.pi, len(free))
+                self.alive[b, free] = True
+
+    def snapshot(self, eod: np.ndarray) -> SnapshotBatch:
+        """The current state as the sensing input."""
+        return SnapshotBatch(agent_xy=self.xy, agent_heading=self.heading, agent_size=self.size,
+                             agent_emitting=eod, pellet_xy=self.pellet_xy, pellet_orientation=self.pellet_phi,
+                             pellet_alive=self.alive, width=self.width, height=self.height)
+
+    def _observe(self, eod: np.ndarray) -> np.ndarray:
+        e = self.cfg.env
+        readings = sense_batch(self.snapshot(eod), self.plan, rng=self.noise_rng)
+        return build_observation(readings, self.last_action, self.was_bitten, self.size, self.bite_cd, self.eat_cd,
+                                 self.displacement, self.v_max(), e.eat_cooldown, e.bite_cooldown, e.obs_agents)
