@@ -35,12 +35,13 @@ def time_env(cfg: EfishConfig, num_envs: int, steps: int, seed: int, reference: 
 
 
 def _reference_observe(env: VecEnv, eod: np.ndarray) -> np.ndarray:
-    from ..env.observe import build_observation
+    from ..env.observe import electric_block, tail_block
 
     e = env.cfg.env
     readings = sense_batch(env.snapshot(eod), env.plan, rng=env.noise_rng, reference=True)
-    return build_observation(readings, env.last_action, env.was_bitten, env.size, env.bite_cd, env.eat_cd,
-                             env.displacement, env.v_max(), e.eat_cooldown, e.bite_cooldown, e.obs_agents)
+    tail = tail_block(env.last_action, env.was_bitten, env.size, env.bite_cd, env.eat_cd, env.displacement,
+                      env.v_max(), e.eat_cooldown, e.bite_cooldown)
+    return np.concatenate([electric_block(readings, e.obs_agents), tail], axis=-1)
 
 
 def bench_env(cfg: EfishConfig, num_envs: int = 16, steps: int = 100, reference_steps: int = 3) -> list[dict]:

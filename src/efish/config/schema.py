@@ -114,6 +114,8 @@ class SensorsConfig:
     ampullary: AmpullaryConfig = group(AmpullaryConfig)
     knollenorgan: KnollenorganConfig = group(KnollenorganConfig)
     noise: NoiseConfig = group(NoiseConfig)
+    ray_count: int = param(36, "ray casting: rays at the Mormyromast angles (first ray_count of them)", lo=1, hi=1024)
+    ray_length_cm: float = param(100.0, "ray casting: ray length, cm", lo=0.0)
 
 
 # ----------------------------------------------------------------------- arena
@@ -184,6 +186,16 @@ class EnvConfig:
     frozen: list = param([], "agent ids that never move or turn")
     sizes: list = param([], "fixed sizes per agent; empty = U(0, 1) per episode")
     starts: list = param([], "fixed starts per agent as [x_cm, y_cm, heading_rad]; empty = random")
+    task: str = param("foraging", "reward and termination rules", choices=("foraging", "homing"))
+    bots: list = param([], "agent ids driven by the bounded random-walk bot instead of the policy")
+    bot_eod_rate: float = param(0.5, "bot: probability of an EOD each step", lo=0.0, hi=1.0)
+    bot_radius_cm: float = param(8.5, "bot: random walk bounded in this circle around the arena centre", lo=0.0)
+    homing_target: int = param(0, "homing: agent id of the frozen, always-emitting target", lo=0)
+    homing_radius_cm: float = param(4.0, "homing: within this distance of the target counts as home", lo=0.0)
+    homing_success_steps: int = param(5, "homing: consecutive steps at home that end the episode", lo=1)
+    homing_reward_home: float = param(10.0, "homing: reward per step at home")
+    homing_shaping: float = param(0.01, "homing: times (d_prev - d) / perimeter")
+    homing_step_cost: float = param(0.05, "homing: cost per step")
 
 
 # ----------------------------------------------------------------------- scene
@@ -260,12 +272,14 @@ def _check_consistency(obj: Any, path: str) -> None:
     if isinstance(obj, EnvConfig):
         if obj.n_agents > obj.obs_agents:
             raise ConfigError(f"{path}n_agents={obj.n_agents} exceeds {path}obs_agents={obj.obs_agents} (observation slots)")
-        for key in ("muted", "frozen"):
+        for key in ("muted", "frozen", "bots"):
             bad = [i for i in getattr(obj, key) if not (isinstance(i, int) and 0 <= i < obj.n_agents)]
             if bad:
                 raise ConfigError(f"{path}{key} has agent ids {bad} outside 0..{obj.n_agents - 1}")
         if obj.sizes and (len(obj.sizes) != obj.n_agents or any(not 0 <= v <= 1 for v in obj.sizes)):
             raise ConfigError(f"{path}sizes must hold {obj.n_agents} values in [0, 1]")
+        if obj.task == "homing" and obj.homing_target >= obj.n_agents:
+            raise ConfigError(f"{path}homing_target={obj.homing_target} is not an agent id (0..{obj.n_agents - 1})")
         if obj.starts and (len(obj.starts) != obj.n_agents or any(len(x) != 3 for x in obj.starts)):
             raise ConfigError(f"{path}starts must hold {obj.n_agents} entries [x_cm, y_cm, heading_rad]")
     if isinstance(obj, ArenaConfig):

@@ -27,3 +27,17 @@ def foraging_rewards(cfg: EnvConfig, ate: np.ndarray, d_prev: np.ndarray, d_now:
     }
     parts["total"] = sum(parts.values())
     return parts
+
+
+def homing_rewards(cfg: EnvConfig, d_prev: np.ndarray, d_now: np.ndarray, perimeter: np.ndarray,
+                   is_target: np.ndarray) -> dict[str, np.ndarray]:
+    """Homing reward components (SPEC 7), float64[B, N]; the target itself gets 0."""
+    home = d_now <= cfg.homing_radius_cm
+    homer = ~is_target[None, :]
+    parts = {
+        "home": cfg.homing_reward_home * home * homer,
+        "shaping": cfg.homing_shaping * (d_prev - d_now) / perimeter[:, None] * homer,
+        "step": -cfg.homing_step_cost * homer * np.ones_like(d_now),
+    }
+    parts["total"] = sum(parts.values())
+    return parts

@@ -21,9 +21,12 @@ from ..physics.plan import build_plan
 from ..physics.snapshot import SnapshotBatch
 from ..sensing import sense_batch
 from . import dynamics as dyn
+from ..sensors.layout import mormyromast_angles
 from .arenas import drift_orientations, regrow_onepatch, sample_arena, sample_pellets, spawn_agents
-from .observe import build_observation
-from .rewards import foraging_rewards
+from .bot import bot_actions
+from .observe import electric_block, tail_block
+from .raycast import cast_rays
+from .rewards import foraging_rewards, homing_rewards
 
 
 def _sigmoid(x: np.ndarray) -> np.ndarray:
@@ -58,6 +61,10 @@ class VecEnv:
         self.params[dyn.EAT_CD], self.params[dyn.BITE_CD] = e.eat_cooldown, e.bite_cooldown
         self.muted = np.isin(np.arange(self.n), e.muted)
         self.frozen = np.isin(np.arange(self.n), e.frozen)
+        self.bots = np.isin(np.arange(self.n), e.bots)
+        self.homing = e.task == "homing"
+        self.target = np.arange(self.n) == e.homing_target if self.homing else np.zeros(self.n, bool)
+        self.ray_angles = mormyromast_angles(cfg.sensors.mormyromast)[: cfg.sensors.ray_count]
         self._allocate(pellet_capacity=1)
 
     # ------------------------------------------------------------------ state
@@ -75,6 +82,7 @@ class VecEnv:
         self.width, self.height = np.zeros(b), np.zeros(b)
         self.arena = [self.cfg.arena] * b
         self.t = np.zeros(b, np.int64)
+        self.home_steps = np.zeros((b, n), np.int64)   # consecutive steps at home (homing)
         self._pellets(pellet_capacity)
 
     def _pellets(self, capacity: int) -> None:
@@ -118,6 +126,7 @@ class VecEnv:
         self.last_action[b] = 0.0
         self.was_bitten[b] = False
         self.displacement[b] = 0.0
+        self.home_steps[b] = 0
         self.t[b] = 0
 
     # ------------------------------------------------------------------- API
@@ -125,8 +134,8 @@ class VecEnv:
         """Start a new episode in every arena; observations float32[B, N, D]."""
         for b in range(self.num_envs):
             self._reset_env(b)
-        dyn.nearest_pellet_distance(self.xy, self.pellet_xy, self.alive, self.d_food)
-        return self._observe(np.zeros((self.num_envs, self.n), bool))
+        self._distances(self.d_food)
+        return self._observe(np.zeros((self.num_envs, self.n), bool) | self.target)
 
     def v_max(self) -> np.ndarray:
         """Largest step per agent, cm (SPEC 5): speed * gain * (1 + size) / fps; 0 when frozen."""
@@ -149,13 +158,17 @@ class VecEnv:
         e = self.cfg.env
         # 1. food dynamics
         self._food_dynamics()
-        # 2. map actions, eat, move
+        # 2. map actions (bots and the homing target override theirs), eat, move
         move, turn = _sigmoid(actions[..., 0]), np.tanh(actions[..., 1])
-        eod = (actions[..., 2] > 0.5) & ~self.muted
-        bite = actions[..., 3] > 0.5
+        eod = actions[..., 2] > 0.5
+        bite = (actions[..., 3] > 0.5) & ~self.bots & (not self.homing)
+        if self.bots.any():
+            self._drive_bots(move, turn, eod)
+        eod = (eod & ~self.muted) | self.target
         old_xy = self.xy.copy()
         ate, collided, can_bite = (np.zeros((self.num_envs, self.n), bool) for _ in range(3))
-        dyn.eat_and_move(self.xy, self.heading, self.eat_cd, self.bite_cd, move, turn, bite, self.v_max(),
+        no_eating = bite | self.bots[None, :]  # bots never eat: they enter the kernel as if biting
+        dyn.eat_and_move(self.xy, self.heading, self.eat_cd, self.bite_cd, move, turn, no_eating, self.v_max(),
                          self.w_max(), self.pellet_xy, self.alive, self.width, self.height, self.params,
                          ate, collided, can_bite)
         # 4. bites, simultaneously, on post-move positions (3. sensing happens in _observe)
@@ -165,9 +178,14 @@ class VecEnv:
                           bitten_by, bit, penalty)
         # 5. rewards
         d_prev = self.d_food.copy()
-        dyn.nearest_pellet_distance(self.xy, self.pellet_xy, self.alive, self.d_food)
-        rewards = foraging_rewards(e, ate, d_prev, self.d_food, 2 * (self.width + self.height), penalty, bit,
-                                   collided, move, turn)
+        self._distances(self.d_food)
+        perimeter = 2 * (self.width + self.height)
+        if self.homing:
+            rewards = homing_rewards(e, d_prev, self.d_food, perimeter, self.target)
+            at_home = (self.d_food <= e.homing_radius_cm) & ~self.target
+            self.home_steps = np.where(at_home, self.home_steps + 1, 0)
+        else:
+            rewards = foraging_rewards(e, ate, d_prev, self.d_food, perimeter, penalty, bit, collided, move, turn)
         # 6. observations
         delta = self.xy - old_xy
         c, s = np.cos(self.heading), np.sin(self.heading)
@@ -175,19 +193,20 @@ class VecEnv:
         self.last_action = np.stack([move, turn, eod, bite], axis=-1).astype(np.float64)
         self.was_bitten = bitten_by > 0
         info = {"ate": ate, "bit": bit, "was_bitten": self.was_bitten.copy(), "collided": collided, "eod": eod,
-                "reward_parts": rewards, "d_food_cm": self.d_food.copy()}
+                "reward_parts": rewards, ("d_target_cm" if self.homing else "d_food_cm"): self.d_food.copy()}
         obs = self._observe(eod)
         # 7. time limit: truncation, then same-step reset
         self.t += 1
         truncated = self.t >= e.episode_steps
-        terminated = np.zeros(self.num_envs, bool)
+        terminated = (self.home_steps >= e.homing_success_steps).any(axis=1) if self.homing \
+            else np.zeros(self.num_envs, bool)
         done = truncated | terminated
         if done.any():
             info["final_obs"] = obs.copy()
             for b in np.flatnonzero(done):
                 self._reset_env(b)
-            dyn.nearest_pellet_distance(self.xy, self.pellet_xy, self.alive, self.d_food)
-            obs[done] = self._observe(np.zeros((self.num_envs, self.n), bool))[done]
+            self._distances(self.d_food)
+            obs[done] = self._observe(np.zeros((self.num_envs, self.n), bool) | self.target)[done]
         return obs, rewards["total"], terminated, truncated, info
 
     # --------------------------------------------------------------- helpers
@@ -209,8 +228,36 @@ class VecEnv:
                              agent_emitting=eod, pellet_xy=self.pellet_xy, pellet_orientation=self.pellet_phi,
                              pellet_alive=self.alive, width=self.width, height=self.height)
 
+    def _distances(self, out: np.ndarray) -> None:
+        """Distance driving the shaping reward: nearest pellet (foraging) or the target (homing)."""
+        if self.homing:
+            out[:] = np.linalg.norm(self.xy - self.xy[:, self.target], axis=-1)
+        else:
+            dyn.nearest_pellet_distance(self.xy, self.pellet_xy, self.alive, out)
+
+    def _drive_bots(self, move: np.ndarray, turn: np.ndarray, eod: np.ndarray) -> None:
+        e, ids = self.cfg.env, np.flatnonzero(self.bots)
+        w_max = self.w_max()
+        for b in range(self.num_envs):
+            centre = np.array([self.width[b], self.height[b]]) / 2
+            m, t, f = bot_actions(self.xy[b, ids], self.heading[b, ids], w_max[b, ids], centre, e.bot_radius_cm,
+                                  e.bot_eod_rate, self.rngs[b])
+            move[b, ids], turn[b, ids], eod[b, ids] = m, t, f
+
+    def perception(self, eod: np.ndarray) -> np.ndarray:
+        """The sensory part of the observation: electric receptors or rays."""
+        if self.cfg.sensors.perception == "raycast":
+            shape = (self.num_envs, self.n, len(self.ray_angles))
+            prox, kind = np.zeros(shape), np.zeros(shape)
+            cast_rays(self.xy, self.heading, self.pellet_xy, self.alive, self.width, self.height, self.ray_angles,
+                      self.cfg.sensors.ray_length_cm, self.cfg.env.body_radius_cm, self.cfg.physics.pellet_radius_cm,
+                      prox, kind)
+            return np.concatenate([prox, kind], axis=-1).astype(np.float32)
+        readings = sense_batch(self.snapshot(eod), self.plan, rng=self.noise_rng)
+        return electric_block(readings, self.cfg.env.obs_agents)
+
     def _observe(self, eod: np.ndarray) -> np.ndarray:
         e = self.cfg.env
-        readings = sense_batch(self.snapshot(eod), self.plan, rng=self.noise_rng)
-        return build_observation(readings, self.last_action, self.was_bitten, self.size, self.bite_cd, self.eat_cd,
-                                 self.displacement, self.v_max(), e.eat_cooldown, e.bite_cooldown, e.obs_agents)
+        tail = tail_block(self.last_action, self.was_bitten, self.size, self.bite_cd, self.eat_cd, self.displacement,
+                          self.v_max(), e.eat_cooldown, e.bite_cooldown)
+        return np.concatenate([self.perception(eod), tail], axis=-1)
