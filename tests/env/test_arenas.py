@@ -129,7 +129,7 @@ def test_training_layout_must_be_resolved_first():
 def test_orientation_drift_has_the_configured_spread():
     cfg = arena("patchy70")
     phi = np.full(20000, np.pi)
-    step = drift_orientations(phi, cfg, np.random.default_rng(5)) - np.pi
+    step = drift_orientations(phi, cfg.orientation_drift_rad, np.random.default_rng(5)) - np.pi
     assert abs(step.std() - 0.1) < 0.005 and abs(step.mean()) < 0.005
 
 

@@ -90,9 +90,9 @@ def regrow_onepatch(cfg: ArenaConfig, n_alive: int, rng: np.random.Generator) ->
     return points_in_disc(centre, cfg.onepatch_radius_cm, count, cfg.width_cm, cfg.height_cm, rng)
 
 
-def drift_orientations(phi: np.ndarray, cfg: ArenaConfig, rng: np.random.Generator) -> np.ndarray:
-    """Pellet orientations after one step of drift N(0, sd), wrapped to [0, 2 pi)."""
-    return np.mod(phi + rng.normal(0.0, cfg.orientation_drift_rad, np.shape(phi)), 2 * np.pi)
+def drift_orientations(phi: np.ndarray, sd: float | np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Pellet orientations after one step of drift N(0, sd) (``sd`` broadcasts), wrapped to [0, 2 pi)."""
+    return np.mod(phi + np.asarray(sd) * rng.standard_normal(np.shape(phi)), 2 * np.pi)
 
 
 def points_in_disc(centre: np.ndarray, radius: float, count: int, w: float, h: float,

@@ -211,16 +211,21 @@ class VecEnv:
 
     # --------------------------------------------------------------- helpers
     def _food_dynamics(self) -> None:
-        for b in range(self.num_envs):
+        """Orientation drift of every pellet (one draw for the batch), then one-patch regrowth."""
+        sd = np.array([a.orientation_drift_rad for a in self.arena])[:, None]
+        self.pellet_phi = drift_orientations(self.pellet_phi, sd, self.noise_rng)
+        for b in self._regrowing:
             arena, rng = self.arena[b], self.rngs[b]
-            live = self.alive[b]
-            self.pellet_phi[b, live] = drift_orientations(self.pellet_phi[b, live], arena, rng)
-            new = regrow_onepatch(arena, int(live.sum()), rng)
+            new = regrow_onepatch(arena, int(self.alive[b].sum()), rng)
             if len(new):
                 free = np.flatnonzero(~self.alive[b])[: len(new)]
                 self.pellet_xy[b, free] = new[: len(free)]
                 self.pellet_phi[b, free] = rng.uniform(0, 2 * np.pi, len(free))
                 self.alive[b, free] = True
+
+    @property
+    def _regrowing(self) -> list[int]:
+        return [b for b, a in enumerate(self.arena) if a.layout == "onepatch"]
 
     def snapshot(self, eod: np.ndarray) -> SnapshotBatch:
         """The current state as the sensing input."""

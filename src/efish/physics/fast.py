@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 
 from . import kernels as kn
@@ -43,6 +45,30 @@ def kernel_constants(plan: EffectPlan) -> tuple[np.ndarray, np.ndarray]:
     return c.astype(dtype), f
 
 
+_PREPARED: "weakref.WeakKeyDictionary[EffectPlan, tuple]" = weakref.WeakKeyDictionary()
+
+
+def prepared_inputs(plan: EffectPlan) -> tuple:
+    """Everything the batch kernel needs from a plan, in the kernel dtype; built once per plan."""
+    if plan not in _PREPARED:
+        dtype = np.dtype(plan.dtype)
+
+        def arr(x):
+            return np.ascontiguousarray(np.asarray(x, dtype=np.float64), dtype=dtype)
+
+        c, flags = kernel_constants(plan)
+        angles = (plan.morm_angles, plan.amp_angles)
+        tables = np.zeros((4, max(len(a) for a in angles)))
+        for row, a in enumerate(angles):
+            tables[2 * row, :len(a)], tables[2 * row + 1, :len(a)] = np.cos(a), np.sin(a)
+        _PREPARED[plan] = (
+            plan.image_indices, arr(plan.image_weights), c, flags, arr(tables),
+            np.array(plan.far_levels, dtype=np.int64), *level_tables(plan), arr(plan.far_tables),
+            arr(plan.morm_interp.transpose(0, 2, 1)), arr(plan.amp_interp.transpose(0, 2, 1)),
+            arr(np.cos(plan.knollen_angles)), arr(np.sin(plan.knollen_angles)))
+    return _PREPARED[plan]
+
+
 def fast_raw(batch: SnapshotBatch, plan: EffectPlan) -> RawReadings:
     """Raw readings of every receptor of every agent with the numba kernels, in ``plan.dtype``."""
     dtype = np.dtype(plan.dtype)
@@ -50,7 +76,8 @@ def fast_raw(batch: SnapshotBatch, plan: EffectPlan) -> RawReadings:
     out = empty_readings(b, n, plan, dtype)
     if not plan.on("fields"):
         return out
-    c, flags = kernel_constants(plan)
+    inputs = prepared_inputs(plan)
+    flags = inputs[3]
     if not (flags[kn.DO_MORM] or flags[kn.DO_AMP] or flags[kn.DO_KNOLL]):
         return out
     emitting = np.ascontiguousarray(batch.agent_emitting & plan.on("eod_emission"))
@@ -58,18 +85,10 @@ def fast_raw(batch: SnapshotBatch, plan: EffectPlan) -> RawReadings:
     def arr(x, scale=1.0):
         return np.ascontiguousarray(np.asarray(x, dtype=np.float64) * scale, dtype=dtype)
 
-    angles = (plan.morm_angles, plan.amp_angles)
-    tables = np.zeros((4, max(len(a) for a in angles)))
-    for row, a in enumerate(angles):
-        tables[2 * row, :len(a)], tables[2 * row + 1, :len(a)] = np.cos(a), np.sin(a)
     sense_batch_kernel(
         arr(batch.agent_xy, CM), arr(batch.agent_heading), emitting,
         arr(batch.pellet_xy, CM), arr(batch.pellet_orientation), np.ascontiguousarray(batch.pellet_alive),
-        arr(batch.width, CM), arr(batch.height, CM), plan.image_indices, arr(plan.image_weights), c, flags,
-        arr(tables), np.array(plan.far_levels, dtype=np.int64), *level_tables(plan), arr(plan.far_tables),
-        arr(plan.morm_interp.transpose(0, 2, 1)), arr(plan.amp_interp.transpose(0, 2, 1)),
-        arr(np.cos(plan.knollen_angles)), arr(np.sin(plan.knollen_angles)),
-        out.mormyromast, out.ampullary, out.knollenorgan)
+        arr(batch.width, CM), arr(batch.height, CM), *inputs, out.mormyromast, out.ampullary, out.knollenorgan)
     return out
 
 

@@ -43,7 +43,7 @@ class Effect:
     why: str
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # identity equality: plans key caches of kernel inputs
 class EffectPlan:
     """Which kernels run and every derived constant they need (SI units)."""
 
