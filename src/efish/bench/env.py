@@ -18,7 +18,8 @@ def _random_actions(rng: np.random.Generator, b: int, n: int) -> np.ndarray:
     return np.concatenate([rng.normal(size=(b, n, 2)), rng.integers(0, 2, (b, n, 2))], axis=-1)
 
 
-def time_env(cfg: EfishConfig, num_envs: int, steps: int, seed: int, reference: bool = False) -> float:
+def time_env(cfg: EfishConfig, num_envs: int, steps: int, seed: int, reference: bool = False,
+             repeats: int = 3) -> float:
     """Agent-steps per second of ``steps`` random-action steps of ``num_envs`` arenas (one thread)."""
     env = VecEnv(cfg, num_envs=num_envs, seed=seed)
     if reference:  # same env, sensing through the brute-force oracle
@@ -30,7 +31,7 @@ def time_env(cfg: EfishConfig, num_envs: int, steps: int, seed: int, reference: 
     def run():
         for a in acts:
             env.step(a)
-    seconds = best_time(run, repeats=1 if reference else 3)
+    seconds = best_time(run, repeats=1 if reference else repeats)
     return num_envs * env.n * steps / seconds
 
 
@@ -52,7 +53,7 @@ def bench_env(cfg: EfishConfig, num_envs: int = 16, steps: int = 100, reference_
 
         scene = compose([f"arena={arena}", f"env.n_agents={4 if arena == 'patchy70' else 2}"])
         scene = dataclasses.replace(scene, env=dataclasses.replace(scene.env, episode_steps=10**9))
-        fast = time_env(scene, num_envs, steps, seed=cfg.bench.seed)
+        fast = time_env(scene, num_envs, steps, seed=cfg.bench.seed, repeats=cfg.bench.repeats)
         ref = time_env(scene, num_envs, reference_steps, seed=cfg.bench.seed, reference=True)
         rows.append({"scene": label, "num_envs": num_envs, "fast_agent_steps_per_s": fast,
                      "reference_agent_steps_per_s": ref, "speedup": fast / ref})
