@@ -59,7 +59,7 @@ def test_unknown_key(override, key):
     ("physics.image_order=-1", "physics.image_order"),
     ("physics.softening_m=-1", "physics.softening_m"),
     ("physics.image_scale=1.5", "physics.image_scale"),
-    ("scene.n_agents=0", "scene.n_agents"),
+    ("env.n_agents=0", "env.n_agents"),
     ("sensors.mormyromast.count=0", "sensors.mormyromast.count"),
 ])
 def test_out_of_range_value(override, key):
@@ -82,7 +82,7 @@ def test_bad_type(override, key):
     ("physics.dtype=float16", "physics.dtype"),
     ("sensors.perception=sonar", "sensors.perception"),
     ("sensors.mormyromast.g_self=0.5", "sensors.mormyromast.g_self"),
-    ("scene.emitters=some", "scene.emitters"),
+    ("env.task=hunting", "env.task"),
 ])
 def test_bad_choice(override, key):
     msg = one_line_error([override])
@@ -100,8 +100,8 @@ def test_inconsistent_values(overrides, key):
 
 
 def test_missing_config_group_option_is_one_line():
-    msg = one_line_error(["scene=nope"])
-    assert "scene" in msg
+    msg = one_line_error(["arena=nope"])
+    assert "arena" in msg
 
 
 def test_validate_names_the_key_of_a_mutated_tree(default_cfg):

@@ -42,11 +42,11 @@ def test_busy_scene_reads_something_everywhere(default_cfg, busy_scene):
 def test_no_pellets_turns_the_pellet_effect_off(default_cfg):
     assert not build_plan(default_cfg, n_pellets=0).on("pellets")
     assert build_plan(default_cfg, n_pellets=3).on("pellets")
-    assert not build_plan(cfg_with("scene.pellets=false")).on("pellets")
+    assert not build_plan(cfg_with("arena.layout=none")).on("pellets")
 
 
 def test_pellets_absent_from_the_scene_config_are_not_sensed(busy_scene):
-    cfg = cfg_with("scene.pellets=false", "physics.image_order=0")
+    cfg = cfg_with("arena.layout=none", "physics.image_order=0")
     without = sense(replace(busy_scene, pellet_xy=np.zeros((0, 2)), pellet_orientation=np.zeros(0)), cfg)
     ignored = sense(busy_scene, cfg)
     for name in RECEPTORS:
@@ -54,7 +54,7 @@ def test_pellets_absent_from_the_scene_config_are_not_sensed(busy_scene):
 
 
 def test_emitters_none_turns_induction_and_knollenorgan_off(busy_scene):
-    cfg = cfg_with("scene.emitters=none")
+    cfg = cfg_with("env.muted=[0,1,2,3]")
     plan = build_plan(cfg)
     assert not plan.on("eod_emission")
     assert not plan.on("induction")
@@ -129,7 +129,7 @@ def test_closed_gates_turn_induction_off():
 
 
 def test_single_agent_scene_has_no_conspecific_effects():
-    plan = build_plan(cfg_with("scene.n_agents=1"))
+    plan = build_plan(cfg_with("env.n_agents=1"))
     assert not plan.on("knollenorgan") and not plan.on("cons_part")
 
 
@@ -163,7 +163,7 @@ def test_plan_constants_in_si_units(default_cfg):
 
 
 def test_explain_mentions_every_effect(default_cfg):
-    for cfg in (default_cfg, cfg_with("sensors.perception=raycast"), cfg_with("scene.emitters=none")):
+    for cfg in (default_cfg, cfg_with("sensors.perception=raycast"), cfg_with("env.muted=[0,1,2,3]")):
         plan = build_plan(cfg, tolerance=0.0)
         text = plan.explain()
         assert "tolerance 0" in text

@@ -18,7 +18,7 @@ from ..physics.snapshot import Snapshot, SnapshotBatch
 def benchmark_snapshot(cfg: EfishConfig, rng: np.random.Generator, foraging: bool) -> Snapshot:
     """One 4-agent patchy snapshot; ``foraging`` puts every agent near a pellet."""
     a = cfg.arena
-    n = cfg.scene.n_agents
+    n = cfg.env.n_agents
     pellets = sample_pellets(a, rng)
     xy = spawn_agents(n, a.width_cm, a.height_cm, a.wall_margin_cm, rng)
     if foraging and len(pellets):

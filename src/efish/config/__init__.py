@@ -5,7 +5,6 @@ from .schema import (
     ConfigError,
     EfishConfig,
     PhysicsConfig,
-    SceneConfig,
     SensorsConfig,
     validate,
 )
@@ -14,7 +13,6 @@ __all__ = [
     "ConfigError",
     "EfishConfig",
     "PhysicsConfig",
-    "SceneConfig",
     "SensorsConfig",
     "compose",
     "config_dir",

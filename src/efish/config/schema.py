@@ -198,16 +198,6 @@ class EnvConfig:
     homing_step_cost: float = param(0.05, "homing: cost per step")
 
 
-# ----------------------------------------------------------------------- scene
-@dataclass
-class SceneConfig:
-    """What a scene contains, as far as the effect plan needs to know."""
-
-    n_agents: int = param(4, "agents in the scene", lo=1, hi=64)
-    pellets: bool = param(True, "the scene has food pellets")
-    emitters: str = param("any", "which agents can emit: any, none (all muted)", choices=("any", "none"))
-
-
 # ----------------------------------------------------------------------- bench
 @dataclass
 class BenchConfig:
@@ -238,7 +228,6 @@ class EfishConfig:
     sensors: SensorsConfig = group(SensorsConfig)
     arena: ArenaConfig = group(ArenaConfig)
     env: EnvConfig = group(EnvConfig)
-    scene: SceneConfig = group(SceneConfig)
     bench: BenchConfig = group(BenchConfig)
     scale: ScaleConfig = group(ScaleConfig)
 

@@ -1,7 +1,8 @@
 """The effect plan: simulate only what the scene calls for.
 
-A scene config says which effects exist; :func:`build_plan` turns the config
-into an :class:`EffectPlan` once per episode. Kernels for absent effects are
+The config says which effects exist (physics switches, receptor classes,
+gates, the arena's food layout, the env's agents and who is muted);
+:func:`build_plan` turns it into an :class:`EffectPlan` once per episode. Kernels for absent effects are
 not called at all, and every number the kernels need is derived here in SI
 units, so kernels never see a config. ``efish plan <overrides>`` prints
 :meth:`EffectPlan.explain`.
@@ -116,19 +117,21 @@ def build_plan(cfg: EfishConfig, *, tolerance: float | None = None, dtype: str |
                n_agents: int | None = None) -> EffectPlan:
     """Decide which effects run for the scene in ``cfg`` and derive the kernel constants.
 
-    ``n_pellets``, ``any_emitter`` and ``n_agents`` refine the decision for a
-    known episode (no pellets -> no pellet loops; nobody can emit -> no
-    induction; a lone agent -> no conspecific channels); they override the
-    scene config.
+    The scene comes from ``cfg.env`` (agents, who is muted, the homing target
+    that always emits) and ``cfg.arena`` (layout ``none`` has no pellets).
+    ``n_pellets``, ``any_emitter`` and ``n_agents`` override it for a known
+    episode (no pellets -> no pellet loops; nobody can emit -> no induction;
+    a lone agent -> no conspecific channels).
     """
-    ph, se, sc = cfg.physics, cfg.sensors, cfg.scene
-    agents = sc.n_agents if n_agents is None else n_agents
+    ph, se, env = cfg.physics, cfg.sensors, cfg.env
+    agents = env.n_agents if n_agents is None else n_agents
     tol = ph.tolerance if tolerance is None else float(tolerance)
     if not tol >= 0:
         raise ValueError(f"tolerance must be >= 0, got {tolerance}")
     electric = se.perception == "electric"
-    pellets = sc.pellets and (n_pellets is None or n_pellets > 0)
-    emitters = ph.emission and sc.emitters != "none" and (any_emitter is None or any_emitter)
+    pellets = cfg.arena.layout != "none" and (n_pellets is None or n_pellets > 0)
+    all_muted = set(range(env.n_agents)) <= set(env.muted) and env.task != "homing"
+    emitters = ph.emission and not all_muted and (any_emitter is None or any_emitter)
     m_on, a_on, k_on = (electric and se.mormyromast.enabled, electric and se.ampullary.enabled,
                         electric and se.knollenorgan.enabled)
     gates_open = se.mormyromast.g_self > 0 or se.mormyromast.g_cons > 0
@@ -146,7 +149,7 @@ def build_plan(cfg: EfishConfig, *, tolerance: float | None = None, dtype: str |
         Effect("knollenorgan", k_on and emitters and agents > 1,
                "off: no conspecifics" if agents < 2 else
                ("off: nobody can emit, every spike is 0" if k_on and not emitters else why_receptor("knollenorgan", se.knollenorgan.enabled))),
-        Effect("eod_emission", emitters, "agents may emit" if emitters else "off: emission disabled or every agent muted"),
+        Effect("eod_emission", emitters, "agents may emit" if emitters else "off: physics.emission false or every agent muted"),
         Effect("induction", m_on and emitters and ph.induction and gates_open,
                "induced dipoles feed Mormyromasts" if m_on and emitters and ph.induction and gates_open else
                "off: " + ("no Mormyromasts" if not m_on else "no emitters" if not emitters else
@@ -160,7 +163,7 @@ def build_plan(cfg: EfishConfig, *, tolerance: float | None = None, dtype: str |
                else "off: the self part is gated out (g_self = 0)"),
         Effect("intrinsic_fields", a_on and ph.intrinsic, "intrinsic dipoles feed Ampullary organs" if a_on and ph.intrinsic else
                "off: " + ("no Ampullary organs" if not a_on else "physics.intrinsic is false")),
-        Effect("pellets", pellets, "pellet sources in the loops" if pellets else "off: the scene has no pellets"),
+        Effect("pellets", pellets, "pellet sources in the loops" if pellets else "off: no pellets (arena.layout none)"),
         Effect("wall_images", electric and walls, f"image order {ph.image_order}, scale {ph.image_scale:g}" if walls else "off: image order 0 or scale 0"),
         Effect("noise", electric and se.noise.enabled, "multiplicative, seeded" if se.noise.enabled else "off: sensors.noise.enabled is false"),
         Effect("culling", electric and tol > 0, f"sources below {tol:g} x E_min skipped" if tol > 0 else "off: tolerance 0 computes every source"),
