@@ -1,0 +1,1 @@
+"""Recurrent MAPPO: networks, action distribution, advantages, value normalisation."""

@@ -1,0 +1,88 @@
+"""Actor and critic of SPEC 9: LayerNorm(input) -> [Linear-ReLU-LayerNorm] x 2 -> GRU -> LayerNorm -> head.
+
+Both step one time step at a time (rollouts) and run whole chunks of a
+sequence (BPTT in training); masks zero the hidden state at episode starts in
+both, so the two give the same outputs for the same sequence.
+"""
+
+from __future__ import annotations
+
+import math
+
+import torch
+from torch import nn
+
+from .distributions import ActionDistribution
+
+
+def _orthogonal(layer: nn.Linear, gain: float) -> nn.Linear:
+    nn.init.orthogonal_(layer.weight, gain)
+    nn.init.zeros_(layer.bias)
+    return layer
+
+
+class RecurrentTrunk(nn.Module):
+    """Feature MLP and GRU shared by actor and critic (separate instances, separate weights)."""
+
+    def __init__(self, input_dim: int, hidden: int):
+        super().__init__()
+        relu_gain = math.sqrt(2)
+        self.mlp = nn.Sequential(
+            nn.LayerNorm(input_dim),
+            _orthogonal(nn.Linear(input_dim, hidden), relu_gain), nn.ReLU(), nn.LayerNorm(hidden),
+            _orthogonal(nn.Linear(hidden, hidden), relu_gain), nn.ReLU(), nn.LayerNorm(hidden),
+        )
+        self.gru = nn.GRU(hidden, hidden)
+        for name, p in self.gru.named_parameters():
+            if "weight" in name:
+                nn.init.orthogonal_(p)
+            else:
+                nn.init.zeros_(p)
+        self.out_norm = nn.LayerNorm(hidden)
+        self.hidden = hidden
+
+    def forward(self, x: torch.Tensor, h: torch.Tensor, starts: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        """x [T, B, D], h [B, H] before the chunk, starts [T, B] (1 where an episode begins).
+
+        Returns features [T, B, H] and the hidden state after the chunk [B, H].
+        """
+        feats = self.mlp(x)
+        outs = []
+        keep = (1.0 - starts.to(x.dtype)).unsqueeze(-1)
+        for t in range(x.shape[0]):
+            h = h * keep[t]
+            out, h_next = self.gru(feats[t].unsqueeze(0), h.unsqueeze(0))
+            h = h_next.squeeze(0)
+            outs.append(out.squeeze(0))
+        return self.out_norm(torch.stack(outs)), h
+
+
+class Actor(nn.Module):
+    """Policy: trunk -> (move/turn means, EOD/bite logits); log-std state-independent, init 0."""
+
+    def __init__(self, obs_dim: int, hidden: int, head_gain: float = 0.01):
+        super().__init__()
+        self.trunk = RecurrentTrunk(obs_dim, hidden)
+        self.head = _orthogonal(nn.Linear(hidden, 4), head_gain)
+        self.log_std = nn.Parameter(torch.zeros(2))
+
+    def forward(self, obs: torch.Tensor, h: torch.Tensor, starts: torch.Tensor
+                ) -> tuple[ActionDistribution, torch.Tensor, torch.Tensor]:
+        """obs [T, B, D] -> distribution over [T, B] actions, final hidden [B, H], features [T, B, H]."""
+        feats, h = self.trunk(obs, h, starts)
+        out = self.head(feats)
+        return ActionDistribution(out[..., :2], self.log_std.expand_as(out[..., :2]), out[..., 2:]), h, feats
+
+
+class Critic(nn.Module):
+    """Centralised value: trunk over the concatenated observations of all agents -> scalar."""
+
+    def __init__(self, state_dim: int, hidden: int, head_gain: float = 0.01):
+        super().__init__()
+        self.trunk = RecurrentTrunk(state_dim, hidden)
+        self.head = _orthogonal(nn.Linear(hidden, 1), head_gain)
+
+    def forward(self, state: torch.Tensor, h: torch.Tensor, starts: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        """state [T, B, N*D] -> values [T, B], final hidden [B, H]."""
+        feats, h = self.trunk(state, h, starts)
+        return self.head(feats).squeeze(-1), h

@@ -1,0 +1,105 @@
+"""Distributions, GAE, value normalisation and the recurrent networks (SPEC 9)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import torch
+
+from efish.rl.advantages import gae
+from efish.rl.distributions import ActionDistribution
+from efish.rl.networks import Actor, Critic
+from efish.rl.value_norm import ValueNormalizer
+
+
+def random_dist(gen: torch.Generator, shape=(5, 3), scale=3.0) -> ActionDistribution:
+    return ActionDistribution(torch.randn(*shape, 2, generator=gen, dtype=torch.float64),
+                              0.5 * torch.randn(*shape, 2, generator=gen, dtype=torch.float64),
+                              scale * torch.randn(*shape, 2, generator=gen, dtype=torch.float64))
+
+
+def test_log_prob_and_entropy_match_torch_distributions():
+    gen = torch.Generator().manual_seed(0)
+    d = random_dist(gen)
+    a = d.sample(gen)
+    normal = torch.distributions.Normal(d.mean, d.log_std.exp())
+    bern = torch.distributions.Bernoulli(logits=d.logits)
+    expected = normal.log_prob(a[..., :2]).sum(-1) + bern.log_prob(a[..., 2:]).sum(-1)
+    torch.testing.assert_close(d.log_prob(a), expected)
+    torch.testing.assert_close(d.entropy(), normal.entropy().sum(-1) + bern.entropy().sum(-1))
+
+
+def test_bernoulli_heads_saturate_without_nan():
+    d = ActionDistribution(torch.zeros(4, 2), torch.zeros(4, 2), torch.tensor([[100.0, -100.0]] * 4))
+    a = torch.tensor([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0], [0.0, 0.0, 1.0, 1.0], [0.0, 0.0, 0.0, 0.0]])
+    lp = d.log_prob(a)
+    assert torch.isfinite(lp).all() and torch.isfinite(d.entropy()).all()
+    assert lp[0] == pytest.approx(-2 * 0.5 * np.log(2 * np.pi), abs=1e-6)  # the likely outcome costs nothing
+    assert lp[1] < -190  # the impossible outcome costs about 200 nats, not -inf
+    assert torch.equal(d.mode()[:, 2:], torch.tensor([[1.0, 0.0]] * 4))
+
+
+def test_gae_matches_a_hand_computed_example_with_truncation_and_termination():
+    r = torch.tensor([[1.0], [2.0], [3.0], [4.0]])
+    v = torch.tensor([[0.5], [1.0], [1.5], [2.0]])
+    nv = torch.tensor([[1.0], [1.5], [9.0], [7.0]])  # step 2 terminated (9 is ignored), step 3 truncated
+    term = torch.tensor([[False], [False], [True], [False]])
+    trunc = torch.tensor([[False], [False], [False], [True]])
+    g, lam = 0.9, 0.8
+    d3 = 4 + g * 7 - 2.0
+    d2 = 3 - 1.5
+    d1 = 2 + g * 1.5 - 1.0
+    d0 = 1 + g * 1.0 - 0.5
+    expected = torch.tensor([[d0 + g * lam * (d1 + g * lam * d2)], [d1 + g * lam * d2], [d2], [d3]])
+    adv, ret = gae(r, v, nv, term, trunc, g, lam)
+    torch.testing.assert_close(adv, expected)
+    torch.testing.assert_close(ret, expected + v)
+
+
+def test_value_normalizer_tracks_exact_running_moments():
+    vn = ValueNormalizer(eps=0.0)
+    data = np.random.default_rng(0).normal(3.0, 2.0, 1000)
+    for chunk in np.split(data, [100, 350, 351, 900]):
+        vn.update(torch.tensor(chunk))
+    assert float(vn.mean) == pytest.approx(data.mean(), rel=1e-12)
+    assert float(vn.var) == pytest.approx(data.var(), rel=1e-12)
+    x = torch.tensor(data[:10])
+    torch.testing.assert_close(vn.denormalize(vn.normalize(x)), x)
+
+
+@pytest.mark.parametrize("net", ["actor", "critic"])
+def test_chunked_forward_equals_step_by_step_with_episode_resets(net):
+    torch.manual_seed(0)
+    model = Actor(7, 16) if net == "actor" else Critic(7, 16)
+    steps, batch = 12, 3
+    x = torch.randn(steps, batch, 7)
+    starts = torch.zeros(steps, batch)
+    starts[5, 0] = starts[0, :] = starts[9, 2] = 1.0
+    h0 = torch.randn(batch, 16)
+
+    def out_of(result):
+        return result[0].mean if net == "actor" else result[0]
+
+    full = model(x, h0, starts)
+    h, step_outs = h0, []
+    for t in range(steps):
+        r = model(x[t:t + 1], h, starts[t:t + 1])
+        step_outs.append(out_of(r))
+        h = r[1]
+    torch.testing.assert_close(out_of(full), torch.cat(step_outs))
+    torch.testing.assert_close(full[1], h)
+
+
+def test_episode_start_forgets_the_hidden_state():
+    torch.manual_seed(1)
+    actor = Actor(5, 8)
+    x = torch.randn(1, 2, 5)
+    starts = torch.ones(1, 2)
+    a = actor(x, torch.randn(2, 8), starts)[0].mean
+    b = actor(x, torch.zeros(2, 8), starts)[0].mean
+    torch.testing.assert_close(a, b)
+
+
+def test_heads_start_small():
+    actor = Actor(110, 64)
+    assert actor.head.weight.abs().max() < 0.05 and torch.all(actor.log_std == 0)
