@@ -2,6 +2,7 @@
 
     efish config [overrides]                  print the resolved config
     efish plan [overrides]                    which effects run, and why
+    efish train [overrides] [--out D]         train one seed (checkpoint.pt, metrics.parquet)
     efish bench physics [overrides] [--json]  sensing throughput, fast vs reference
     efish bench accuracy [overrides] --out D  accuracy-vs-time study -> table + figure
     efish bench env [overrides] [--json]      env-only throughput, fast vs reference physics
@@ -31,6 +32,9 @@ def _parser() -> argparse.ArgumentParser:
     c.add_argument("overrides", nargs="*")
     pl = sub.add_parser("plan", help="print the effect plan of a scene")
     pl.add_argument("overrides", nargs="*")
+    tr = sub.add_parser("train", help="train one seed with recurrent MAPPO (resumes from a checkpoint in --out)")
+    tr.add_argument("overrides", nargs="*")
+    tr.add_argument("--out", type=Path, help="output folder (default results/{scale}/train/seed_{seed})")
     b = sub.add_parser("bench", help="speed and accuracy studies")
     bsub = b.add_subparsers(dest="bench", required=True)
     bp = bsub.add_parser("physics", help="sensing throughput: fast path vs reference, one thread")
@@ -61,6 +65,35 @@ def _progress(items: list, label: str):
             print(f"{label}: {i}/{len(items)} {item}", file=sys.stderr, flush=True)
             yield item
     return lines()
+
+
+def _train(args, cfg, started) -> None:
+    from .io import write_run_metadata
+    from .rl.train import train
+
+    out = args.out or Path(f"results/{cfg.scale.name}/train/seed_{cfg.train.seed}")
+    write_run_metadata(out, to_yaml(cfg), started)
+    bar = None
+    if sys.stderr.isatty():
+        from tqdm import tqdm
+
+        bar = tqdm(unit="update", desc=f"seed {cfg.train.seed}")
+
+    def report(row: dict, total: int) -> None:
+        line = (f"update {row['update']}/{total}  env-steps {row['env_steps']:,}  return {row['episode_return']:.3f}  "
+                f"{row['env_steps_per_s']:,.0f} env-steps/s")
+        if bar is not None:
+            bar.total = total
+            bar.set_postfix_str(line.split("  ", 1)[1])
+            bar.update(1)
+        else:
+            print(line, file=sys.stderr, flush=True)
+
+    df = train(cfg, out, progress=report)
+    if bar is not None:
+        bar.close()
+    write_run_metadata(out, to_yaml(cfg), started)
+    print(f"trained {len(df)} updates into {out}")
 
 
 def _bench_physics(args, cfg, started) -> None:
@@ -103,6 +136,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         cfg = compose(args.overrides)
         if args.command == "config":
             print(to_yaml(cfg), end="")
+        elif args.command == "train":
+            _train(args, cfg, started)
         elif args.command == "plan":
             from .physics.plan import build_plan
 

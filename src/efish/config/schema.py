@@ -198,6 +198,34 @@ class EnvConfig:
     homing_step_cost: float = param(0.05, "homing: cost per step")
 
 
+# ----------------------------------------------------------------------- train
+@dataclass
+class TrainConfig:
+    """Recurrent MAPPO (SPEC 9)."""
+
+    hidden: int = param(512, "width of every layer and of the GRU", lo=1, hi=8192)
+    head_gain: float = param(0.01, "orthogonal init gain of the output heads", lo=0.0)
+    lr: float = param(5e-4, "Adam learning rate (actor and critic)", lo=0.0, hi=1.0)
+    adam_eps: float = param(1e-5, "Adam epsilon", lo=0.0)
+    weight_decay: float = param(1e-6, "Adam weight decay", lo=0.0)
+    epochs: int = param(15, "PPO epochs per update", lo=1)
+    minibatches: int = param(1, "minibatches per epoch (split over sequences)", lo=1)
+    clip: float = param(0.2, "PPO ratio clip and value clip", lo=0.0, hi=1.0)
+    entropy_coef: float = param(0.01, "entropy bonus", lo=0.0)
+    value_coef: float = param(1.0, "value loss weight", lo=0.0)
+    huber_delta: float = param(10.0, "Huber loss delta of the value loss", lo=0.0)
+    max_grad_norm: float = param(10.0, "gradient norm clip", lo=0.0)
+    gamma: float = param(0.995, "discount", lo=0.0, hi=1.0)
+    gae_lambda: float = param(0.95, "GAE lambda", lo=0.0, hi=1.0)
+    num_envs: int = param(16, "parallel arenas per rollout", lo=1)
+    rollout_steps: int = param(1600, "steps per rollout", lo=1)
+    chunk: int = param(100, "BPTT chunk length; must divide rollout_steps", lo=1)
+    total_steps: int = param(5_000_000, "env steps per seed (arena steps x arenas)", lo=1)
+    checkpoint_every: int = param(10, "updates between checkpoints", lo=1)
+    threads: int = param(1, "torch threads", lo=1, hi=256)
+    seed: int = param(1, "training seed", lo=0)
+
+
 # ----------------------------------------------------------------------- bench
 @dataclass
 class BenchConfig:
@@ -228,6 +256,7 @@ class EfishConfig:
     sensors: SensorsConfig = group(SensorsConfig)
     arena: ArenaConfig = group(ArenaConfig)
     env: EnvConfig = group(EnvConfig)
+    train: TrainConfig = group(TrainConfig)
     bench: BenchConfig = group(BenchConfig)
     scale: ScaleConfig = group(ScaleConfig)
 
@@ -258,6 +287,8 @@ def validate(obj: Any, path: str = "") -> None:
 
 def _check_consistency(obj: Any, path: str) -> None:
     """Cross-field rules that a single range cannot express."""
+    if isinstance(obj, TrainConfig) and obj.rollout_steps % obj.chunk:
+        raise ConfigError(f"{path}chunk={obj.chunk} must divide {path}rollout_steps={obj.rollout_steps}")
     if isinstance(obj, EnvConfig):
         if obj.n_agents > obj.obs_agents:
             raise ConfigError(f"{path}n_agents={obj.n_agents} exceeds {path}obs_agents={obj.obs_agents} (observation slots)")

@@ -14,6 +14,8 @@ generator per arena (food, spawn, sizes) and one for sensor noise.
 
 from __future__ import annotations
 
+import copy
+
 import numpy as np
 
 from ..config.schema import EfishConfig
@@ -27,6 +29,9 @@ from .bot import bot_actions
 from .observe import electric_block, tail_block
 from .raycast import cast_rays
 from .rewards import foraging_rewards, homing_rewards
+
+
+_DERIVED = ("cfg", "plan", "params", "muted", "frozen", "bots", "homing", "target", "ray_angles")
 
 
 def _sigmoid(x: np.ndarray) -> np.ndarray:
@@ -208,6 +213,14 @@ class VecEnv:
             self._distances(self.d_food)
             obs[done] = self._observe(np.zeros((self.num_envs, self.n), bool) | self.target)[done]
         return obs, rewards["total"], terminated, truncated, info
+
+    def state_dict(self) -> dict:
+        """A deep copy of the mutable state (arrays, arenas, generators) for checkpoints."""
+        return copy.deepcopy({k: v for k, v in self.__dict__.items() if k not in _DERIVED})
+
+    def load_state_dict(self, state: dict) -> None:
+        """Restore what :meth:`state_dict` returned."""
+        self.__dict__.update(copy.deepcopy(state))
 
     # --------------------------------------------------------------- helpers
     def _food_dynamics(self) -> None:

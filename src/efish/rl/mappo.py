@@ -1,0 +1,90 @@
+"""One recurrent MAPPO update: the losses and the epochs over BPTT chunks (SPEC 9)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import torch
+import torch.nn.functional as F
+
+from ..config.schema import TrainConfig
+from .networks import Actor, Critic
+from .value_norm import ValueNormalizer
+
+
+@dataclass
+class Rollout:
+    """One rollout, time-major: [T, S] with S = arenas x agents sequences.
+
+    obs [T, S, D]; state [T, S, N*D] (the agent's own observation first);
+    actions [T, S, 4]; logp, values (normalised), advantages, returns [T, S];
+    starts [T, S] (1 on the first step of an episode); h_actor, h_critic
+    [T/L, S, H] hidden states at the start of each chunk of length L.
+    """
+
+    obs: torch.Tensor
+    state: torch.Tensor
+    actions: torch.Tensor
+    logp: torch.Tensor
+    values: torch.Tensor
+    advantages: torch.Tensor
+    returns: torch.Tensor
+    starts: torch.Tensor
+    h_actor: torch.Tensor
+    h_critic: torch.Tensor
+
+
+def chunked(x: torch.Tensor, chunk: int) -> torch.Tensor:
+    """[T, S, ...] -> [L, (T/L) * S, ...]: every chunk becomes its own sequence."""
+    t, s = x.shape[:2]
+    return x.reshape(t // chunk, chunk, s, *x.shape[2:]).transpose(0, 1).reshape(chunk, (t // chunk) * s, *x.shape[2:])
+
+
+def ppo_update(cfg: TrainConfig, actor: Actor, critic: Critic, actor_opt: torch.optim.Optimizer,
+               critic_opt: torch.optim.Optimizer, value_norm: ValueNormalizer, ro: Rollout,
+               generator: torch.Generator) -> dict[str, float]:
+    """Epochs of clipped-surrogate and clipped-Huber-value updates; returns mean statistics."""
+    value_norm.update(ro.returns)
+    targets = value_norm.normalize(ro.returns)
+    adv = (ro.advantages - ro.advantages.mean()) / (ro.advantages.std() + 1e-8)
+    L = cfg.chunk
+    data = {k: chunked(v, L) for k, v in dict(obs=ro.obs, state=ro.state, actions=ro.actions, logp=ro.logp,
+                                                values=ro.values, adv=adv, targets=targets, starts=ro.starts).items()}
+    h_a, h_c = ro.h_actor.reshape(-1, ro.h_actor.shape[-1]), ro.h_critic.reshape(-1, ro.h_critic.shape[-1])
+    n_seq = h_a.shape[0]
+    stats: dict[str, list[float]] = {k: [] for k in ("policy_loss", "value_loss", "entropy", "approx_kl", "clip_fraction")}
+    for _ in range(cfg.epochs):
+        order = torch.randperm(n_seq, generator=generator)
+        for idx in order.chunk(cfg.minibatches):
+            dist, _, _ = actor(data["obs"][:, idx], h_a[idx], data["starts"][:, idx])
+            logp = dist.log_prob(data["actions"][:, idx])
+            ratio = torch.exp(logp - data["logp"][:, idx])
+            a = data["adv"][:, idx]
+            policy_loss = -torch.min(ratio * a, ratio.clamp(1 - cfg.clip, 1 + cfg.clip) * a).mean()
+            entropy = dist.entropy().mean()
+            actor_opt.zero_grad()
+            (policy_loss - cfg.entropy_coef * entropy).backward()
+            torch.nn.utils.clip_grad_norm_(actor.parameters(), cfg.max_grad_norm)
+            actor_opt.step()
+
+            values, _ = critic(data["state"][:, idx], h_c[idx], data["starts"][:, idx])
+            old, tgt = data["values"][:, idx], data["targets"][:, idx]
+            clipped = old + (values - old).clamp(-cfg.clip, cfg.clip)
+            value_loss = torch.max(F.huber_loss(values, tgt, delta=cfg.huber_delta, reduction="none"),
+                                   F.huber_loss(clipped, tgt, delta=cfg.huber_delta, reduction="none")).mean()
+            critic_opt.zero_grad()
+            (cfg.value_coef * value_loss).backward()
+            torch.nn.utils.clip_grad_norm_(critic.parameters(), cfg.max_grad_norm)
+            critic_opt.step()
+
+            with torch.no_grad():
+                log_ratio = logp - data["logp"][:, idx]
+                stats["approx_kl"].append(float(((ratio - 1) - log_ratio).mean()))
+                stats["clip_fraction"].append(float(((ratio - 1).abs() > cfg.clip).float().mean()))
+            stats["policy_loss"].append(policy_loss.item())
+            stats["value_loss"].append(value_loss.item())
+            stats["entropy"].append(entropy.item())
+    out = {k: sum(v) / len(v) for k, v in stats.items()}
+    var = float(ro.returns.var())
+    out["explained_variance"] = 1.0 - float((ro.returns - value_norm.denormalize(ro.values)).var()) / var if var > 0 else 0.0
+    return out

@@ -1,0 +1,183 @@
+"""``train(cfg, out_dir)``: recurrent MAPPO on the VecEnv, resumable (SPEC 9, DESIGN "Training").
+
+Readable top to bottom: collect a rollout with the current policy, compute
+advantages, run the PPO epochs, log one metrics row, checkpoint. A checkpoint
+holds the networks, optimisers, value normaliser, every RNG state and the
+environment state, so a resumed run ends with the same weights as an
+uninterrupted one.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import torch
+
+from ..config.schema import EfishConfig
+from ..env.vec_env import VecEnv
+from ..io import atomic_path
+from .advantages import gae
+from .mappo import Rollout, ppo_update
+from .networks import Actor, Critic
+from .value_norm import ValueNormalizer
+
+CHECKPOINT = "checkpoint.pt"
+METRICS = "metrics.parquet"
+
+
+def agent_centric_state(obs: np.ndarray) -> np.ndarray:
+    """[B, N, D] -> [B, N, N*D]: each agent's critic input, its own observation first, then the others in id order."""
+    n = obs.shape[1]
+    order = np.array([[i] + [j for j in range(n) if j != i] for i in range(n)])
+    return obs[:, order].reshape(obs.shape[0], n, -1)
+
+
+class Learner:
+    """Networks, optimisers and value normaliser of one seed."""
+
+    def __init__(self, cfg: EfishConfig, obs_dim: int, n_agents: int):
+        t = cfg.train
+        torch.manual_seed(t.seed)
+        self.actor = Actor(obs_dim, t.hidden, t.head_gain)
+        self.critic = Critic(obs_dim * n_agents, t.hidden, t.head_gain)
+        self.value_norm = ValueNormalizer()
+        self.actor_opt = torch.optim.Adam(self.actor.parameters(), lr=t.lr, eps=t.adam_eps, weight_decay=t.weight_decay)
+        self.critic_opt = torch.optim.Adam(self.critic.parameters(), lr=t.lr, eps=t.adam_eps, weight_decay=t.weight_decay)
+        self.architecture = {"obs_dim": obs_dim, "n_agents": n_agents, "hidden": t.hidden}
+
+
+def collect(cfg: EfishConfig, env: VecEnv, learner: Learner, carry: dict, generator: torch.Generator
+            ) -> tuple[Rollout, dict]:
+    """Step the env ``rollout_steps`` times with the current policy; returns the rollout and episode stats."""
+    t_cfg = cfg.train
+    T, L, B, N = t_cfg.rollout_steps, t_cfg.chunk, env.num_envs, env.n
+    S = B * N
+    obs_np, h_a, h_c, starts_now = carry["obs"], carry["h_actor"], carry["h_critic"], carry["starts"]
+    buf = {k: [] for k in ("obs", "state", "actions", "logp", "values", "rewards", "terminated", "truncated",
+                           "starts", "next_values")}
+    h_actor_chunks, h_critic_chunks, returns_done, parts = [], [], [], {}
+    with torch.no_grad():
+        for t in range(T):
+            if t % L == 0:
+                h_actor_chunks.append(h_a.clone())
+                h_critic_chunks.append(h_c.clone())
+            obs = torch.as_tensor(obs_np.reshape(1, S, -1))
+            state = torch.as_tensor(agent_centric_state(obs_np).reshape(1, S, -1))
+            dist, h_a, _ = learner.actor(obs, h_a, starts_now[None])
+            values, h_c = learner.critic(state, h_c, starts_now[None])
+            actions = dist.sample(generator)
+            next_obs, reward, term, trunc, info = env.step(actions.reshape(B, N, 4).numpy())
+            done = np.repeat(term | trunc, N)
+            next_values = torch.zeros(S)
+            if trunc.any():  # bootstrap truncated episodes from their final observation
+                final = info["final_obs"]
+                fs = torch.as_tensor(agent_centric_state(final).reshape(1, S, -1))
+                nv, _ = learner.critic(fs, h_c, torch.zeros(1, S))
+                next_values = learner.value_norm.denormalize(nv[0])
+            for k, v in (("obs", obs[0]), ("state", state[0]), ("actions", actions[0]), ("logp", dist.log_prob(actions)[0]),
+                         ("values", values[0]), ("rewards", torch.as_tensor(reward.reshape(S), dtype=torch.float32)),
+                         ("terminated", torch.as_tensor(np.repeat(term, N))),
+                         ("truncated", torch.as_tensor(np.repeat(trunc, N))), ("starts", starts_now),
+                         ("next_values", next_values)):
+                buf[k].append(v)
+            for name, v in info["reward_parts"].items():
+                parts[name] = parts.get(name, 0.0) + float(v.mean())
+            carry["episode_return"] += reward.reshape(S)
+            if done.any():
+                returns_done += carry["episode_return"][done].tolist()
+                carry["episode_return"][done] = 0.0
+            starts_now = torch.as_tensor(done, dtype=torch.float32)
+            obs_np = next_obs
+        # V(s_{t+1}) within the episode: the next step's value, or the bootstrap at truncation
+        last_state = torch.as_tensor(agent_centric_state(obs_np).reshape(1, S, -1))
+        last_value, _ = learner.critic(last_state, h_c, starts_now[None])
+    data = {k: torch.stack(v) for k, v in buf.items()}
+    values_dn = learner.value_norm.denormalize(data["values"])
+    following = torch.cat([values_dn[1:], learner.value_norm.denormalize(last_value)])
+    next_v = torch.where(data["truncated"], data["next_values"], following)
+    adv, ret = gae(data["rewards"], values_dn, next_v, data["terminated"], data["truncated"], t_cfg.gamma,
+                   t_cfg.gae_lambda)
+    carry.update(obs=obs_np, h_actor=h_a, h_critic=h_c, starts=starts_now)
+    ro = Rollout(obs=data["obs"], state=data["state"], actions=data["actions"], logp=data["logp"], values=data["values"],
+                 advantages=adv, returns=ret, starts=data["starts"], h_actor=torch.stack(h_actor_chunks),
+                 h_critic=torch.stack(h_critic_chunks))
+    episode = {"episode_return": float(np.mean(returns_done)) if returns_done else float("nan"),
+               **{f"reward_{k}": v / T for k, v in parts.items()}}
+    return ro, episode
+
+
+def train(cfg: EfishConfig, out_dir: str | Path, progress=None) -> pd.DataFrame:
+    """Train one seed into ``out_dir`` (checkpoint.pt, metrics.parquet); resumes from a checkpoint there."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    t_cfg = cfg.train
+    torch.set_num_threads(t_cfg.threads)
+    env = VecEnv(cfg, num_envs=t_cfg.num_envs, seed=t_cfg.seed)
+    obs = env.reset()
+    learner = Learner(cfg, obs.shape[-1], env.n)
+    S, H = env.num_envs * env.n, t_cfg.hidden
+    carry = {"obs": obs, "h_actor": torch.zeros(S, H), "h_critic": torch.zeros(S, H), "starts": torch.ones(S),
+             "episode_return": np.zeros(S)}
+    generator = torch.Generator().manual_seed(t_cfg.seed)
+    rows, update = [], 0
+    if (out / CHECKPOINT).exists():
+        update, rows = load_checkpoint(out / CHECKPOINT, learner, env, carry, generator)
+    steps_per_update = t_cfg.rollout_steps * t_cfg.num_envs
+    total_updates = max(1, t_cfg.total_steps // steps_per_update)
+    start = time.perf_counter()
+    while update < total_updates:
+        t0 = time.perf_counter()
+        ro, episode = collect(cfg, env, learner, carry, generator)
+        losses = ppo_update(t_cfg, learner.actor, learner.critic, learner.actor_opt, learner.critic_opt,
+                            learner.value_norm, ro, generator)
+        update += 1
+        seconds = time.perf_counter() - t0
+        rows.append({"update": update, "env_steps": update * steps_per_update, "wall_s": time.perf_counter() - start,
+                     **episode, **losses, "env_steps_per_s": steps_per_update / seconds})
+        if progress:
+            progress(rows[-1], total_updates)
+        if update % t_cfg.checkpoint_every == 0 or update == total_updates:
+            save_checkpoint(out / CHECKPOINT, learner, env, carry, generator, update, rows)
+            with atomic_path(out / METRICS) as tmp:
+                pd.DataFrame(rows).to_parquet(tmp, index=False)
+    return pd.DataFrame(rows)
+
+
+def save_checkpoint(path: Path, learner: Learner, env: VecEnv, carry: dict, generator: torch.Generator,
+                    update: int, rows: list[dict]) -> None:
+    """Everything a resumed run needs to continue bit for bit, written atomically."""
+    state = {
+        "architecture": learner.architecture, "update": update, "metrics": rows,
+        "actor": learner.actor.state_dict(), "critic": learner.critic.state_dict(),
+        "value_norm": learner.value_norm.state_dict(),
+        "actor_opt": learner.actor_opt.state_dict(), "critic_opt": learner.critic_opt.state_dict(),
+        "torch_rng": torch.get_rng_state(), "generator": generator.get_state(),
+        "env": env.state_dict(), "carry": carry,
+    }
+    with atomic_path(path) as tmp:
+        torch.save(state, tmp)
+
+
+def load_checkpoint(path: Path, learner: Learner, env: VecEnv, carry: dict, generator: torch.Generator
+                    ) -> tuple[int, list[dict]]:
+    """Restore a checkpoint into live objects; one clear error if it does not fit."""
+    try:
+        state = torch.load(path, weights_only=False)
+    except Exception as exc:  # truncated or foreign file
+        raise ValueError(f"cannot read checkpoint {path}: {type(exc).__name__}") from None
+    if state.get("architecture") != learner.architecture:
+        raise ValueError(f"checkpoint {path} is for architecture {state.get('architecture')}, "
+                         f"not {learner.architecture}")
+    learner.actor.load_state_dict(state["actor"])
+    learner.critic.load_state_dict(state["critic"])
+    learner.value_norm.load_state_dict(state["value_norm"])
+    learner.actor_opt.load_state_dict(state["actor_opt"])
+    learner.critic_opt.load_state_dict(state["critic_opt"])
+    torch.set_rng_state(state["torch_rng"])
+    generator.set_state(state["generator"])
+    env.load_state_dict(state["env"])
+    carry.update(state["carry"])
+    return state["update"], list(state["metrics"])
