@@ -6,6 +6,7 @@
     efish bench physics [overrides] [--json]  sensing throughput, fast vs reference
     efish bench accuracy [overrides] --out D  accuracy-vs-time study -> table + figure
     efish bench env [overrides] [--json]      env-only throughput, fast vs reference physics
+    efish bench train [overrides] [--json]    rollout/update speed, model-FLOP utilisation
 
 Overrides are Hydra's ``key=value`` (``physics.image_order=2``) or group
 choices (``arena=patchy70``). Every error is one line on stderr, exit code 2,
@@ -46,6 +47,10 @@ def _parser() -> argparse.ArgumentParser:
     be.add_argument("--json", action="store_true", help="print JSON instead of a table")
     be.add_argument("--envs", type=int, default=16, help="arenas stepped together (default 16)")
     be.add_argument("--steps", type=int, default=100, help="timed steps (default 100)")
+    bt = bsub.add_parser("train", help="rollout/update speed and model-FLOP utilisation")
+    bt.add_argument("overrides", nargs="*")
+    bt.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    bt.add_argument("--hidden", type=int, nargs="+", default=[512, 64], help="widths to time (default 512 64)")
     ba = bsub.add_parser("accuracy", help="accuracy-vs-time sweep: table and figure")
     ba.add_argument("overrides", nargs="*")
     ba.add_argument("--out", type=Path, default=Path("results/bench"), help="output folder (default results/bench)")
@@ -144,6 +149,11 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(build_plan(cfg).explain())
         elif args.bench == "physics":
             _bench_physics(args, cfg, started)
+        elif args.bench == "train":
+            from .bench.train import bench_train, format_train
+
+            rows = bench_train(cfg, tuple(args.hidden))
+            print(json.dumps(rows, indent=2) if args.json else format_train(rows))
         elif args.bench == "env":
             from .bench.env import bench_env, format_env
 

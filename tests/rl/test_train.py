@@ -55,3 +55,40 @@ def test_checkpoint_of_another_architecture_is_rejected(tmp_path):
     train(tiny(1), tmp_path)
     with pytest.raises(ValueError, match="architecture"):
         train(tiny(2, "train.hidden=8"), tmp_path)
+
+
+def test_loaded_policy_steps_the_env_with_hidden_states_exposed(tmp_path):
+    from efish.env import VecEnv
+    from efish.rl.policy import load_policy
+
+    cfg = tiny(1)
+    train(cfg, tmp_path)
+    policy = load_policy(tmp_path)
+    env = VecEnv(cfg, num_envs=3, seed=0)
+    obs, h = env.reset(), policy.initial_hidden(3)
+    starts = np.ones(3)
+    for _ in range(5):
+        actions, h_next = policy.act(obs, h, starts)
+        assert actions.shape == (3, 2, 4) and h_next.shape == (3, 2, 16)
+        assert set(np.unique(actions[..., 2:])) <= {0.0, 1.0}
+        obs, _, term, trunc, _ = env.step(actions)
+        h, starts = h_next, (term | trunc).astype(float)
+    # the same inputs give the same deterministic actions
+    np.testing.assert_array_equal(policy.act(obs, h, starts)[0], policy.act(obs, h, starts)[0])
+
+
+def test_load_policy_names_a_missing_checkpoint(tmp_path):
+    from efish.rl.policy import load_policy
+
+    with pytest.raises(ValueError, match="no checkpoint"):
+        load_policy(tmp_path / "nothing")
+
+
+def test_bench_train_reports_positive_rates_and_an_mfu_below_one():
+    from efish.bench.train import bench_train, forward_flops
+
+    assert forward_flops(10, 4, 2) == 2 * 10 * 4 + 2 * 4 * 4 + 12 * 4 * 4 + 2 * 4 * 2
+    rows = bench_train(compose(["env.n_agents=2", "train.num_envs=2", "train.chunk=10", "train.rollout_steps=20"]),
+                       (8,), sequences=2, steps=20, rollout_steps=10)
+    for r in rows:
+        assert r["update_samples_per_s"] > 0 and r["rollout_env_steps_per_s"] > 0 and 0 < r["mfu"] < 1

@@ -223,6 +223,7 @@ class TrainConfig:
     total_steps: int = param(5_000_000, "env steps per seed (arena steps x arenas)", lo=1)
     checkpoint_every: int = param(10, "updates between checkpoints", lo=1)
     threads: int = param(1, "torch threads", lo=1, hi=256)
+    bf16: bool = param(False, "bf16 autocast of forward passes (CPUs with bf16 support)")
     seed: int = param(1, "training seed", lo=0)
 
 

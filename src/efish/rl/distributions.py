@@ -25,6 +25,10 @@ class ActionDistribution:
     log_std: torch.Tensor
     logits: torch.Tensor
 
+    def to(self, dtype: torch.dtype) -> "ActionDistribution":
+        """The same distribution with parameters cast (e.g. back to float32 after bf16 autocast)."""
+        return ActionDistribution(self.mean.to(dtype), self.log_std.to(dtype), self.logits.to(dtype))
+
     def sample(self, generator: torch.Generator | None = None) -> torch.Tensor:
         """Stochastic actions (training)."""
         noise = torch.randn(self.mean.shape, generator=generator, dtype=self.mean.dtype, device=self.mean.device)

@@ -34,6 +34,11 @@ class Rollout:
     h_critic: torch.Tensor
 
 
+def autocast(cfg: TrainConfig):
+    """bf16 autocast of forward passes when ``train.bf16`` is on (a no-op context otherwise)."""
+    return torch.autocast(device_type="cpu", dtype=torch.bfloat16, enabled=cfg.bf16)
+
+
 def chunked(x: torch.Tensor, chunk: int) -> torch.Tensor:
     """[T, S, ...] -> [L, (T/L) * S, ...]: every chunk becomes its own sequence."""
     t, s = x.shape[:2]
@@ -56,7 +61,9 @@ def ppo_update(cfg: TrainConfig, actor: Actor, critic: Critic, actor_opt: torch.
     for _ in range(cfg.epochs):
         order = torch.randperm(n_seq, generator=generator)
         for idx in order.chunk(cfg.minibatches):
-            dist, _, _ = actor(data["obs"][:, idx], h_a[idx], data["starts"][:, idx])
+            with autocast(cfg):
+                dist, _, _ = actor(data["obs"][:, idx], h_a[idx], data["starts"][:, idx])
+            dist = dist.to(torch.float32)
             logp = dist.log_prob(data["actions"][:, idx])
             ratio = torch.exp(logp - data["logp"][:, idx])
             a = data["adv"][:, idx]
@@ -67,7 +74,9 @@ def ppo_update(cfg: TrainConfig, actor: Actor, critic: Critic, actor_opt: torch.
             torch.nn.utils.clip_grad_norm_(actor.parameters(), cfg.max_grad_norm)
             actor_opt.step()
 
-            values, _ = critic(data["state"][:, idx], h_c[idx], data["starts"][:, idx])
+            with autocast(cfg):
+                values, _ = critic(data["state"][:, idx], h_c[idx], data["starts"][:, idx])
+            values = values.float()
             old, tgt = data["values"][:, idx], data["targets"][:, idx]
             clipped = old + (values - old).clamp(-cfg.clip, cfg.clip)
             value_loss = torch.max(F.huber_loss(values, tgt, delta=cfg.huber_delta, reduction="none"),

@@ -1,0 +1,102 @@
+"""``efish bench train``: rollout, update and end-to-end speed, and model-FLOP utilisation.
+
+MFU = achieved model FLOP/s of the PPO update / GEMM FLOP/s measured in the same
+run at the same dtype (fp32, and bf16 where the CPU has it). Model FLOPs are
+counted analytically: 2 per multiply-add of every Linear and GRU matrix,
+backward = 2 x forward.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+
+import torch
+
+from ..config.schema import EfishConfig
+from ..rl.mappo import Rollout, ppo_update
+from ..rl.networks import Actor, Critic
+from ..rl.value_norm import ValueNormalizer
+from .timing import best_time
+
+
+def gemm_flops(dtype: torch.dtype, n: int = 1024, repeats: int = 5) -> float:
+    """FLOP/s of an n x n matrix product at ``dtype`` (best of ``repeats``)."""
+    a, b = torch.randn(n, n).to(dtype), torch.randn(n, n).to(dtype)
+    return 2 * n ** 3 / best_time(lambda: a @ b, repeats)
+
+
+def forward_flops(input_dim: int, hidden: int, out_dim: int) -> int:
+    """Multiply-add FLOPs of one trunk + head forward for one sample (LayerNorms neglected)."""
+    mlp = 2 * input_dim * hidden + 2 * hidden * hidden
+    gru = 2 * 3 * (hidden * hidden + hidden * hidden)
+    return mlp + gru + 2 * hidden * out_dim
+
+
+def update_rate(cfg: EfishConfig, obs_dim: int, n_agents: int, sequences: int, steps: int) -> tuple[float, float]:
+    """(samples/s, model FLOP/s) of one PPO epoch on a synthetic rollout."""
+    t = dataclasses.replace(cfg.train, epochs=1, minibatches=1, rollout_steps=steps)
+    actor, critic = Actor(obs_dim, t.hidden), Critic(obs_dim * n_agents, t.hidden)
+    opt_a, opt_c = torch.optim.Adam(actor.parameters()), torch.optim.Adam(critic.parameters())
+    n_chunks = steps // t.chunk
+    ro = Rollout(obs=torch.randn(steps, sequences, obs_dim), state=torch.randn(steps, sequences, obs_dim * n_agents),
+                 actions=torch.randn(steps, sequences, 4).clamp(0, 1).round(), logp=torch.zeros(steps, sequences),
+                 values=torch.zeros(steps, sequences), advantages=torch.randn(steps, sequences),
+                 returns=torch.randn(steps, sequences), starts=torch.zeros(steps, sequences),
+                 h_actor=torch.zeros(n_chunks, sequences, t.hidden), h_critic=torch.zeros(n_chunks, sequences, t.hidden))
+    gen = torch.Generator().manual_seed(0)
+    seconds = best_time(lambda: ppo_update(t, actor, critic, opt_a, opt_c, ValueNormalizer(), ro, gen), 2)
+    samples = steps * sequences
+    flops = 3 * samples * (forward_flops(obs_dim, t.hidden, 4) + forward_flops(obs_dim * n_agents, t.hidden, 1))
+    return samples / seconds, flops / seconds
+
+
+def rollout_rate(cfg: EfishConfig, steps: int) -> float:
+    """Env-steps/s (arena steps x arenas) of collecting a rollout with an untrained policy."""
+    from ..env.vec_env import VecEnv
+    from ..rl.train import Learner, collect
+
+    t = dataclasses.replace(cfg.train, rollout_steps=steps, chunk=steps)
+    run = dataclasses.replace(cfg, train=t)
+    env = VecEnv(run, num_envs=t.num_envs, seed=0)
+    obs = env.reset()
+    learner = Learner(run, obs.shape[-1], env.n)
+    s = env.num_envs * env.n
+    carry = {"obs": obs, "h_actor": torch.zeros(s, t.hidden), "h_critic": torch.zeros(s, t.hidden),
+             "starts": torch.ones(s), "episode_return": __import__("numpy").zeros(s)}
+    t0 = time.perf_counter()
+    collect(run, env, learner, carry, torch.Generator().manual_seed(0))
+    return steps * t.num_envs / (time.perf_counter() - t0)
+
+
+def bench_train(cfg: EfishConfig, hiddens: tuple[int, ...], sequences: int = 16, steps: int = 100,
+                rollout_steps: int = 50) -> list[dict]:
+    """One row per (hidden width, precision)."""
+    torch.set_num_threads(cfg.train.threads)
+    obs_dim, n_agents = 110, cfg.env.n_agents
+    peaks = {"fp32": gemm_flops(torch.float32)}
+    bf16_ok = torch.backends.mkldnn.is_available() and "AVX512" in torch.backends.cpu.get_cpu_capability()
+    if bf16_ok:
+        peaks["bf16"] = gemm_flops(torch.bfloat16)
+    rows = []
+    for hidden in hiddens:
+        for precision, peak in peaks.items():
+            c = dataclasses.replace(cfg, train=dataclasses.replace(cfg.train, hidden=hidden, bf16=precision == "bf16"))
+            samples_s, flops_s = update_rate(c, obs_dim, n_agents, sequences, steps)
+            env_s = rollout_rate(c, rollout_steps)
+            per_update = c.train.rollout_steps * c.train.num_envs
+            update_s = per_update * n_agents * c.train.epochs / samples_s
+            rows.append({"hidden": hidden, "precision": precision, "gemm_gflops": peak / 1e9,
+                         "update_samples_per_s": samples_s, "update_gflops": flops_s / 1e9, "mfu": flops_s / peak,
+                         "rollout_env_steps_per_s": env_s,
+                         "end_to_end_env_steps_per_s": per_update / (per_update / env_s + update_s)})
+    return rows
+
+
+def format_train(rows: list[dict]) -> str:
+    head = f"{'hidden':>6} {'prec':>5} {'GEMM GF/s':>10} {'update samples/s':>17} {'update GF/s':>12} {'MFU':>6} " \
+           f"{'rollout env-steps/s':>20} {'end-to-end env-steps/s':>23}"
+    lines = [head] + [f"{r['hidden']:>6} {r['precision']:>5} {r['gemm_gflops']:>10.1f} {r['update_samples_per_s']:>17,.0f} "
+                      f"{r['update_gflops']:>12.1f} {r['mfu']:>6.1%} {r['rollout_env_steps_per_s']:>20,.0f} "
+                      f"{r['end_to_end_env_steps_per_s']:>23,.1f}" for r in rows]
+    return "\n".join(lines)

@@ -1,0 +1,56 @@
+"""``load_policy``: a trained actor the rollout code can step, hidden states exposed."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from .networks import Actor
+from .train import CHECKPOINT
+
+
+class Policy:
+    """Steps the actor for [B, N] agents; ``act`` returns actions and the new hidden state.
+
+    Hidden states are numpy arrays [B, N, H] so rollout tables can store them.
+    """
+
+    def __init__(self, actor: Actor, n_agents: int):
+        self.actor = actor.eval()
+        self.n_agents = n_agents
+        self.hidden_size = actor.trunk.hidden
+
+    def initial_hidden(self, num_envs: int) -> np.ndarray:
+        return np.zeros((num_envs, self.n_agents, self.hidden_size), dtype=np.float32)
+
+    @torch.no_grad()
+    def act(self, obs: np.ndarray, hidden: np.ndarray, starts: np.ndarray, deterministic: bool = True,
+            generator: torch.Generator | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """obs [B, N, D], hidden [B, N, H], starts [B] or [B, N] (1 on an episode's first step) ->
+        (actions [B, N, 4], hidden [B, N, H])."""
+        b, n, _ = obs.shape
+        starts = np.broadcast_to(np.asarray(starts, dtype=np.float32).reshape(b, -1), (b, n))
+        dist, h, _ = self.actor(torch.as_tensor(obs, dtype=torch.float32).reshape(1, b * n, -1),
+                                torch.as_tensor(hidden).reshape(b * n, -1),
+                                torch.as_tensor(starts.reshape(1, b * n).copy()))
+        actions = dist.mode() if deterministic else dist.sample(generator)
+        return actions.reshape(b, n, 4).numpy(), h.reshape(b, n, -1).numpy()
+
+
+def load_policy(path: str | Path) -> Policy:
+    """The actor of a checkpoint (a file, or a training folder holding checkpoint.pt)."""
+    path = Path(path)
+    if path.is_dir():
+        path = path / CHECKPOINT
+    try:
+        state = torch.load(path, weights_only=False)
+        arch = state["architecture"]
+        actor = Actor(arch["obs_dim"], arch["hidden"])
+        actor.load_state_dict(state["actor"])
+    except FileNotFoundError:
+        raise ValueError(f"no checkpoint at {path}") from None
+    except Exception as exc:
+        raise ValueError(f"cannot load a policy from {path}: {type(exc).__name__}") from None
+    return Policy(actor, arch["n_agents"])
