@@ -145,3 +145,12 @@ def test_spawned_agents_keep_the_margin_and_never_overlap():
 def test_spawning_too_many_agents_fails_with_a_clear_error():
     with pytest.raises(ValueError, match="could not place"):
         spawn_agents(50, 5.0, 5.0, 1.0, np.random.default_rng(0), max_tries=2000)
+
+
+def test_homing_training_arenas_have_no_food_and_span_75_to_150_cm():
+    cfg = arena("homing_train")
+    rng = np.random.default_rng(9)
+    draws = [sample_arena(cfg, rng) for _ in range(500)]
+    assert all(d.layout == "none" and len(sample_pellets(d, rng)) == 0 for d in draws)
+    w = np.array([d.width_cm for d in draws])
+    assert w.min() >= 75 and w.max() <= 150 and abs(w.mean() - 112.5) < 3

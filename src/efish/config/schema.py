@@ -149,6 +149,7 @@ class ArenaConfig:
     train_size_exponent: float = param(3.0, "training: see train_size_min_cm", lo=0.0)
     train_patchy_weight: float = param(5.0, "training: odds of patchy against uniform, patchy part", lo=0.0)
     train_uniform_weight: float = param(1.0, "training: odds of patchy against uniform, uniform part", lo=0.0)
+    train_none_weight: float = param(0.0, "training: odds of an arena without food (homing)", lo=0.0)
     train_multiplier_min: float = param(0.5, "training: food multiplier log-uniform in [min, max]", lo=0.0)
     train_multiplier_max: float = param(2.0, "training: see train_multiplier_min", lo=0.0)
     orientation_drift_rad: float = param(0.1, "pellet orientation random walk, sd per step, rad", lo=0.0)
@@ -306,8 +307,8 @@ def _check_consistency(obj: Any, path: str) -> None:
     if isinstance(obj, ArenaConfig):
         if obj.train_multiplier_min > obj.train_multiplier_max or obj.train_multiplier_min <= 0:
             raise ConfigError(f"{path}train_multiplier_min must be > 0 and <= {path}train_multiplier_max")
-        if obj.train_patchy_weight + obj.train_uniform_weight <= 0:
-            raise ConfigError(f"{path}train_patchy_weight + {path}train_uniform_weight must be > 0")
+        if obj.train_patchy_weight + obj.train_uniform_weight + obj.train_none_weight <= 0:
+            raise ConfigError(f"{path}train_patchy_weight, train_uniform_weight and train_none_weight sum to 0")
     if isinstance(obj, PhysicsConfig):
         levels = list(obj.far_field_levels)
         if any(q % 2 == 0 or not 3 <= q <= 63 for q in levels) or levels != sorted(set(levels)):

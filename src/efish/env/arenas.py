@@ -18,14 +18,15 @@ AGENT_RADIUS_CM = 1.0  # bodies are 1 cm circles (SPEC 1); non-overlap means cen
 def sample_arena(cfg: ArenaConfig, rng: np.random.Generator) -> ArenaConfig:
     """The arena of one episode: ``cfg`` itself, or for ``layout=training`` a sampled one.
 
-    Training: W, H each min + span * u^exponent (u ~ U(0, 1)); patchy or uniform
-    with odds patchy_weight : uniform_weight; food multiplier log-uniform.
+    Training: W, H each min + span * u^exponent (u ~ U(0, 1)); patchy, uniform or
+    no food with odds patchy : uniform : none weights; food multiplier log-uniform.
     """
     if cfg.layout != "training":
         return cfg
     w, h = cfg.train_size_min_cm + cfg.train_size_span_cm * rng.uniform(size=2) ** cfg.train_size_exponent
-    p_patchy = cfg.train_patchy_weight / (cfg.train_patchy_weight + cfg.train_uniform_weight)
-    layout = "patchy" if rng.uniform() < p_patchy else "uniform"
+    weights = np.array([cfg.train_patchy_weight, cfg.train_uniform_weight, cfg.train_none_weight])
+    layout = ("patchy", "uniform", "none")[int(np.searchsorted(np.cumsum(weights) / weights.sum(), rng.uniform(),
+                                                                side="right"))]
     m = np.exp(rng.uniform(np.log(cfg.train_multiplier_min), np.log(cfg.train_multiplier_max)))
     return dataclasses.replace(cfg, layout=layout, width_cm=float(w), height_cm=float(h), food_multiplier=float(m))
 
