@@ -31,7 +31,7 @@ from .raycast import cast_rays
 from .rewards import foraging_rewards, homing_rewards
 
 
-_DERIVED = ("cfg", "plan", "params", "muted", "frozen", "bots", "homing", "target", "ray_angles")
+_DERIVED = ("cfg", "plan", "params", "muted", "frozen", "bots", "homing", "target", "ray_angles", "autoreset")
 
 
 def _sigmoid(x: np.ndarray) -> np.ndarray:
@@ -45,13 +45,15 @@ class VecEnv:
     actions (a_move, a_turn, eod, bite): a_move and a_turn are raw Gaussian
     samples mapped by sigmoid and tanh, eod and bite are 0/1. Returns
     ``obs, reward[B, N], terminated[B], truncated[B], info``. Arenas that end
-    are reset in the same call; their last observation is in ``info["final_obs"]``.
+    are reset in the same call; their last observation is in ``info["final_obs"]``
+    (with ``autoreset=False`` they are left as they ended, for recording).
     """
 
-    def __init__(self, cfg: EfishConfig, num_envs: int, seed: int):
+    def __init__(self, cfg: EfishConfig, num_envs: int, seed: int, autoreset: bool = True):
         if num_envs < 1:
             raise ValueError(f"num_envs must be >= 1, got {num_envs}")
         self.cfg, self.num_envs, self.n = cfg, int(num_envs), cfg.env.n_agents
+        self.autoreset = autoreset
         root = np.random.SeedSequence(seed)
         children = root.spawn(num_envs + 1)
         self.rngs = [np.random.default_rng(s) for s in children[:-1]]
@@ -197,7 +199,8 @@ class VecEnv:
         self.displacement = np.stack([c * delta[..., 0] + s * delta[..., 1], -s * delta[..., 0] + c * delta[..., 1]], -1)
         self.last_action = np.stack([move, turn, eod, bite], axis=-1).astype(np.float64)
         self.was_bitten = bitten_by > 0
-        info = {"ate": ate, "bit": bit, "was_bitten": self.was_bitten.copy(), "collided": collided, "eod": eod,
+        info = {"ate": ate, "bit": bit, "was_bitten": self.was_bitten.copy(), "bitten_by": bitten_by,
+                "collided": collided, "eod": eod, "move": move, "turn": turn, "bite": bite,
                 "reward_parts": rewards, ("d_target_cm" if self.homing else "d_food_cm"): self.d_food.copy()}
         obs = self._observe(eod)
         # 7. time limit: truncation, then same-step reset
@@ -206,7 +209,7 @@ class VecEnv:
         terminated = (self.home_steps >= e.homing_success_steps).any(axis=1) if self.homing \
             else np.zeros(self.num_envs, bool)
         done = truncated | terminated
-        if done.any():
+        if done.any() and self.autoreset:
             info["final_obs"] = obs.copy()
             for b in np.flatnonzero(done):
                 self._reset_env(b)

@@ -1,0 +1,1 @@
+"""Policy + env -> Parquet tables with one declared schema (DESIGN "Tables")."""

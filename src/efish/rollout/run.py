@@ -1,0 +1,121 @@
+"""Run a policy in the env and record the rollout tables of SPEC/DESIGN "Tables"."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from ..config.schema import EfishConfig
+from ..env.observe import observation_slices
+from ..env.vec_env import VecEnv
+
+
+def _wrap(a: np.ndarray) -> np.ndarray:
+    return (a + np.pi) % (2 * np.pi) - np.pi
+
+
+def nearest(env: VecEnv) -> dict[str, np.ndarray]:
+    """Distance (cm) and bearing (rad, from the heading) to the nearest agent, pellet and wall; [B, N] each."""
+    xy, h = env.xy, env.heading
+    d = xy[:, None, :, :] - xy[:, :, None, :]                       # [B, N(i), N(j), 2]: j - i
+    dist = np.linalg.norm(d, axis=-1) + np.where(np.eye(env.n, dtype=bool), np.inf, 0.0)
+    j = dist.argmin(axis=-1)
+    pick = np.take_along_axis(d, j[..., None, None], axis=2)[:, :, 0]
+    out = {"dist_agent_cm": dist.min(axis=-1), "bearing_agent_rad": _wrap(np.arctan2(pick[..., 1], pick[..., 0]) - h)}
+    if env.n == 1:
+        out["dist_agent_cm"][:], out["bearing_agent_rad"][:] = np.nan, np.nan
+    p = env.pellet_xy[:, None, :, :] - xy[:, :, None, :]             # [B, N, P, 2]
+    pd_ = np.where(env.alive[:, None, :], np.linalg.norm(p, axis=-1), np.inf)
+    k = pd_.argmin(axis=-1) if pd_.shape[-1] else np.zeros(h.shape, int)
+    has = np.isfinite(pd_.min(axis=-1)) if pd_.shape[-1] else np.zeros(h.shape, bool)
+    pk = np.take_along_axis(p, k[..., None, None], axis=2)[:, :, 0] if pd_.shape[-1] else np.zeros(xy.shape)
+    out["dist_food_cm"] = np.where(has, pd_.min(axis=-1) if pd_.shape[-1] else np.nan, np.nan)
+    out["bearing_food_rad"] = np.where(has, _wrap(np.arctan2(pk[..., 1], pk[..., 0]) - h), np.nan)
+    walls = np.stack([xy[..., 0], env.width[:, None] - xy[..., 0], xy[..., 1], env.height[:, None] - xy[..., 1]], -1)
+    w = walls.argmin(axis=-1)
+    out["dist_wall_cm"] = walls.min(axis=-1)
+    out["bearing_wall_rad"] = _wrap(np.array([np.pi, 0.0, -np.pi / 2, np.pi / 2])[w] - h)
+    return out
+
+
+def run_episodes(cfg: EfishConfig, policy, episodes: int, condition: str = "control", seed: int = 0,
+                 deterministic: bool = True) -> dict[str, pd.DataFrame]:
+    """``episodes`` episodes in parallel arenas; returns the ``steps``, ``episodes`` and ``food`` tables.
+
+    ``policy`` has ``initial_hidden(B)`` and ``act(obs, hidden, starts, deterministic)`` like
+    :class:`efish.rl.policy.Policy`.
+    """
+    env = VecEnv(cfg, num_envs=episodes, seed=seed, autoreset=False)
+    obs = env.reset()
+    hidden, starts = policy.initial_hidden(episodes), np.ones(episodes)
+    T, B, N = cfg.env.episode_steps, episodes, env.n
+    sl = observation_slices(len(env.plan.morm_angles), len(env.plan.amp_angles), len(env.plan.knollen_angles),
+                            cfg.env.obs_agents)
+    electric = cfg.sensors.perception == "electric"
+    food = FoodLog(env)
+    steps, bites_recv = [], np.zeros((B, N), int)
+    for t in range(T):
+        actions, hidden = policy.act(obs, hidden, starts, deterministic)
+        alive_before = env.alive.copy()
+        obs, reward, term, trunc, info = env.step(actions)
+        food.update(env, alive_before, t)
+        row = {
+            "episode": np.repeat(np.arange(B), N), "t": np.full(B * N, t), "agent": np.tile(np.arange(N), B),
+            "x_cm": env.xy[..., 0].ravel(), "y_cm": env.xy[..., 1].ravel(), "heading_rad": env.heading.ravel(),
+            "size": env.size.ravel(), "move": info["move"].ravel(), "turn": info["turn"].ravel(),
+            "eod": info["eod"].ravel(), "bite": info["bite"].ravel(), "ate": info["ate"].ravel(),
+            "bit": info["bit"].ravel(), "was_bitten": info["was_bitten"].ravel(),
+            "collided": info["collided"].ravel(), "reward": reward.ravel(),
+            **{k: v.ravel() for k, v in nearest(env).items()},
+            "morm_abs_mean": np.abs(obs[..., sl["mormyromast"]]).mean(-1).ravel() if electric else np.nan,
+            "amp_abs_mean": np.abs(obs[..., sl["ampullary"]]).mean(-1).ravel() if electric else np.nan,
+            "knollen_spikes": (obs[..., sl["knollenorgan"]] != 0).sum(-1).ravel() if electric else 0,
+        }
+        steps.append(pd.DataFrame(row))
+        bites_recv += info["bitten_by"]
+        starts = np.zeros(B)
+        if (term | trunc).all():
+            break
+    steps_df = pd.concat(steps, ignore_index=True)
+    steps_df.insert(0, "condition", condition)
+    steps_df.insert(3, "t_ms", steps_df["t"] * 1000.0 / cfg.env.fps)
+    g = steps_df.groupby(["episode", "agent"], sort=True)
+    episodes_df = pd.DataFrame({
+        "size": g["size"].first(), "food_eaten": g["ate"].sum(), "eod_probability": g["eod"].mean(),
+        "bites_given": g["bit"].sum(), "mean_nn_dist_cm": g["dist_agent_cm"].mean(), "return": g["reward"].sum(),
+        "steps": g["t"].count()}).reset_index()
+    episodes_df["bites_received"] = bites_recv[episodes_df["episode"], episodes_df["agent"]]
+    episodes_df.insert(0, "condition", condition)
+    food_df = food.table()
+    food_df.insert(0, "condition", condition)
+    return {"steps": steps_df, "episodes": episodes_df, "food": food_df}
+
+
+class FoodLog:
+    """One record per pellet that ever existed: where, when it appeared, when it was eaten (-1: never).
+
+    Pellet slots are reused by regrowth, so records follow slots, not the reverse.
+    A pellet that regrows and is eaten within the same step is not seen (one-patch only).
+    """
+
+    def __init__(self, env: VecEnv):
+        self.records: list[list] = []              # [episode, pellet id, x, y, t_spawned, t_eaten]
+        self.slot = np.full(env.alive.shape, -1)  # record index currently in each slot
+        self.count = np.zeros(env.alive.shape[0], int)  # pellets seen so far per episode
+        for b, k in zip(*np.nonzero(env.alive)):
+            self._spawn(env, b, k, 0)
+
+    def _spawn(self, env: VecEnv, b: int, k: int, t: int) -> None:
+        self.slot[b, k] = len(self.records)
+        self.records.append([b, self.count[b], env.pellet_xy[b, k, 0], env.pellet_xy[b, k, 1], t, -1])
+        self.count[b] += 1
+
+    def update(self, env: VecEnv, alive_before: np.ndarray, t: int) -> None:
+        """Record pellets eaten and regrown during step ``t``."""
+        for b, k in zip(*np.nonzero(alive_before & ~env.alive)):
+            self.records[self.slot[b, k]][5] = t
+        for b, k in zip(*np.nonzero(~alive_before & env.alive)):
+            self._spawn(env, b, k, t)
+
+    def table(self) -> pd.DataFrame:
+        return pd.DataFrame(self.records, columns=["episode", "pellet", "x_cm", "y_cm", "t_spawned", "t_eaten"])
