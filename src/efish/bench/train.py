@@ -20,10 +20,13 @@ from ..rl.value_norm import ValueNormalizer
 from .timing import best_time
 
 
-def gemm_flops(dtype: torch.dtype, n: int = 1024, repeats: int = 5) -> float:
-    """FLOP/s of an n x n matrix product at ``dtype`` (best of ``repeats``)."""
-    a, b = torch.randn(n, n).to(dtype), torch.randn(n, n).to(dtype)
-    return 2 * n ** 3 / best_time(lambda: a @ b, repeats)
+def gemm_flops(dtype: torch.dtype, sizes: tuple[int, ...] = (512, 1024, 2048), repeats: int = 10) -> float:
+    """Peak FLOP/s of square matrix products at ``dtype``: the best over sizes and ``repeats``."""
+    best = 0.0
+    for n in sizes:
+        a, b = torch.randn(n, n).to(dtype), torch.randn(n, n).to(dtype)
+        best = max(best, 2 * n ** 3 / best_time(lambda: a @ b, repeats))
+    return best
 
 
 def forward_flops(input_dim: int, hidden: int, out_dim: int) -> int:

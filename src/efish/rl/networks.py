@@ -47,14 +47,17 @@ class RecurrentTrunk(nn.Module):
         Returns features [T, B, H] and the hidden state after the chunk [B, H].
         """
         feats = self.mlp(x)
+        keep = (1.0 - starts.to(feats.dtype)).unsqueeze(-1)
+        # One fused GRU call per stretch without episode starts (in training usually the whole
+        # chunk); the hidden state is zeroed where a sequence starts, as a step-by-step loop would.
+        cuts = torch.nonzero(starts.any(dim=1)).flatten().tolist()
+        bounds = sorted(set([0, x.shape[0]] + cuts))
         outs = []
-        keep = (1.0 - starts.to(x.dtype)).unsqueeze(-1)
-        for t in range(x.shape[0]):
-            h = h * keep[t]
-            out, h_next = self.gru(feats[t].unsqueeze(0), h.unsqueeze(0))
+        for a, b in zip(bounds[:-1], bounds[1:]):
+            out, h_next = self.gru(feats[a:b], (h * keep[a]).unsqueeze(0))
             h = h_next.squeeze(0)
-            outs.append(out.squeeze(0))
-        return self.out_norm(torch.stack(outs)), h
+            outs.append(out)
+        return self.out_norm(torch.cat(outs)), h
 
 
 class Actor(nn.Module):
