@@ -61,3 +61,17 @@ def test_unknown_scale_fails_before_any_job(tmp_path):
                              str(REPO / "Snakefile"), "--directory", str(tmp_path)], capture_output=True, text=True)
     assert result.returncode != 0
     assert "unknown scale 'huge'" in result.stdout + result.stderr
+
+
+def test_workflow_lints_clean():
+    result = subprocess.run(["snakemake", "--lint", "--snakefile", str(REPO / "Snakefile")], capture_output=True,
+                            text=True, cwd=REPO)
+    assert "Congratulations, your workflow is in a good condition" in result.stdout + result.stderr
+
+
+def test_report_renders_after_a_smoke_run(smoke_run):
+    result = subprocess.run(["snakemake", "--cores", "1", "--config", "scale=smoke", "--report", "report.html",
+                             "--directory", str(smoke_run), "--snakefile", str(smoke_run / "Snakefile")],
+                            capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert (smoke_run / "report.html").stat().st_size > 10_000

@@ -9,6 +9,8 @@ rule bench_physics:
     benchmark:
         "results/{scale}/benchmarks/bench_physics.tsv"
     threads: 1
+    conda:
+        "../envs/efish.yaml"
     shell:
         "efish bench physics scale={wildcards.scale} --out results/{wildcards.scale}/bench > {log} 2>&1"
 
@@ -22,6 +24,8 @@ rule bench_accuracy:
     benchmark:
         "results/{scale}/benchmarks/bench_accuracy.tsv"
     threads: 1
+    conda:
+        "../envs/efish.yaml"
     shell:
         "efish bench accuracy scale={wildcards.scale} --out results/{wildcards.scale}/bench > {log} 2>&1"
 
@@ -30,8 +34,14 @@ rule figure_bench_accuracy:
     input:
         "results/{scale}/bench/bench_accuracy.png",
     output:
-        "figures/{scale}/bench/bench_accuracy.png",
+        report(
+            "figures/{scale}/bench/bench_accuracy.png",
+            caption="../report/bench_accuracy.rst",
+            category="Benchmarks",
+        ),
     log:
         "results/{scale}/logs/figure_bench_accuracy.log",
+    conda:
+        "../envs/efish.yaml"
     shell:
         "cp {input} {output} 2> {log}"
