@@ -6,12 +6,10 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from efish.config import compose
-from efish.env import VecEnv
 from efish.env.observe import ray_observation_slices
 from efish.env.raycast import KIND_AGENT, KIND_FOOD, KIND_NONE, KIND_WALL, cast_rays
 
-from .test_vec_env import BIG, actions, make, place_pellets
+from .test_vec_env import BIG, actions, make
 
 
 def test_bot_stays_within_its_bound_and_emits_at_its_rate():
