@@ -1,0 +1,1 @@
+"""Pure functions on rollout tables; no torch, no simulator (DESIGN)."""

@@ -1,0 +1,57 @@
+"""Seed selection by an ethological criterion (SPEC 10).
+
+Per seed, from its evaluation episodes: mean total food per episode, and the
+median over episodes of slope, intercept and R^2 of the OLS fit
+food_eaten ~ size over the episode's agents. Seeds with a non-positive median
+intercept are dropped; food, slope and R^2 are ranked descending; the smallest
+rank sum wins, ties going to more food.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+
+def ols_fit(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
+    """(slope, intercept, R^2) of y ~ x; R^2 is 0 when y does not vary, NaN slope when x does not."""
+    x, y = np.asarray(x, dtype=np.float64), np.asarray(y, dtype=np.float64)
+    vx = np.var(x)
+    if vx == 0:
+        return np.nan, float(np.mean(y)), np.nan
+    slope = float(np.mean((x - x.mean()) * (y - y.mean())) / vx)
+    intercept = float(y.mean() - slope * x.mean())
+    ss_tot = float(np.sum((y - y.mean()) ** 2))
+    r2 = 0.0 if ss_tot == 0 else 1.0 - float(np.sum((y - intercept - slope * x) ** 2)) / ss_tot
+    return slope, intercept, r2
+
+
+def seed_statistics(episodes: pd.DataFrame) -> pd.DataFrame:
+    """One row per seed from an episodes table with a ``seed`` column (SPEC 10 statistics)."""
+    required = {"seed", "episode", "size", "food_eaten"}
+    if missing := required - set(episodes.columns):
+        raise ValueError(f"episodes table lacks columns {sorted(missing)}")
+    rows = []
+    for seed, s in episodes.groupby("seed", sort=True):
+        fits = np.array([ols_fit(e["size"], e["food_eaten"]) for _, e in s.groupby("episode")])
+        rows.append({"seed": seed, "food_per_episode": s.groupby("episode")["food_eaten"].sum().mean(),
+                     "slope": np.nanmedian(fits[:, 0]), "intercept": np.nanmedian(fits[:, 1]),
+                     "r2": np.nanmedian(fits[:, 2]), "episodes": s["episode"].nunique()})
+    return pd.DataFrame(rows)
+
+
+def rank_seeds(stats: pd.DataFrame) -> pd.DataFrame:
+    """The full ranking table: eligible seeds ranked, the winner first, dropped seeds last."""
+    table = stats.copy()
+    table["eligible"] = table["intercept"] > 0
+    ok = table["eligible"]
+    for col in ("food_per_episode", "slope", "r2"):
+        table[f"rank_{col}"] = np.nan
+        table.loc[ok, f"rank_{col}"] = table.loc[ok, col].rank(ascending=False, method="average")
+    table["rank_sum"] = table[["rank_food_per_episode", "rank_slope", "rank_r2"]].sum(axis=1, min_count=3)
+    table = table.sort_values(["eligible", "rank_sum", "food_per_episode"], ascending=[False, True, False],
+                              na_position="last").reset_index(drop=True)
+    table["selected"] = False
+    if ok.any():
+        table.loc[0, "selected"] = True
+    return table
