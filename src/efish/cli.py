@@ -3,6 +3,8 @@
     efish config [overrides]                  print the resolved config
     efish plan [overrides]                    which effects run, and why
     efish train [overrides] [--out D]         train one seed (checkpoint.pt, metrics.parquet)
+    efish assay [overrides] --policy P        run an assay into steps/episodes/food.parquet
+    efish select EPISODES... --out D          rank seeds, write the ranking and the chosen seed
     efish bench physics [overrides] [--json]  sensing throughput, fast vs reference
     efish bench accuracy [overrides] --out D  accuracy-vs-time study -> table + figure
     efish bench env [overrides] [--json]      env-only throughput, fast vs reference physics
@@ -36,6 +38,13 @@ def _parser() -> argparse.ArgumentParser:
     tr = sub.add_parser("train", help="train one seed with recurrent MAPPO (resumes from a checkpoint in --out)")
     tr.add_argument("overrides", nargs="*")
     tr.add_argument("--out", type=Path, help="output folder (default results/{scale}/train/seed_{seed})")
+    asy = sub.add_parser("assay", help="run an assay with a trained policy into Parquet tables")
+    asy.add_argument("overrides", nargs="*")
+    asy.add_argument("--policy", type=Path, required=True, help="training folder or checkpoint.pt")
+    asy.add_argument("--out", type=Path, help="output folder (default results/{scale}/assays/{assay})")
+    sel = sub.add_parser("select", help="rank seeds from their evaluation episodes (SPEC 10)")
+    sel.add_argument("episodes", nargs="+", type=Path, help="episodes.parquet files in folders named seed_<n>")
+    sel.add_argument("--out", type=Path, required=True, help="folder for ranking.parquet and selected_seed.txt")
     b = sub.add_parser("bench", help="speed and accuracy studies")
     bsub = b.add_subparsers(dest="bench", required=True)
     bp = bsub.add_parser("physics", help="sensing throughput: fast path vs reference, one thread")
@@ -101,6 +110,45 @@ def _train(args, cfg, started) -> None:
     print(f"trained {len(df)} updates into {out}")
 
 
+def _assay(args, cfg, started) -> None:
+    from .io import write_run_metadata
+    from .rl.policy import load_policy
+    from .rollout.assay import run_assay
+    from .rollout.tables import write_tables
+
+    policy = load_policy(args.policy)
+    out = args.out or Path(f"results/{cfg.scale.name}/assays/{cfg.assay.name}")
+    tables = run_assay(args.overrides, policy)
+    write_tables(tables, out)
+    write_run_metadata(out, to_yaml(cfg), started, {"policy": str(args.policy)})
+    print(f"wrote {', '.join(f'{k}.parquet ({len(v)} rows)' for k, v in tables.items())} to {out}")
+
+
+def _select(args, started) -> None:
+    import re
+
+    import pandas as pd
+
+    from .analysis.selection import rank_seeds, seed_statistics
+    from .io import atomic_path, write_text_atomic
+
+    frames = []
+    for path in args.episodes:
+        m = re.search(r"seed_(\d+)", str(path))
+        if not m:
+            raise ValueError(f"cannot tell the seed of {path}: put it under a folder named seed_<n>")
+        frames.append(pd.read_parquet(path).assign(seed=int(m.group(1))))
+    table = rank_seeds(seed_statistics(pd.concat(frames, ignore_index=True)))
+    if table["fallback"].any():
+        print("efish: warning: no seed has a positive median intercept; ranked all seeds (fallback)", file=sys.stderr)
+    with atomic_path(args.out / "ranking.parquet") as tmp:
+        table.to_parquet(tmp, index=False)
+    chosen = int(table.loc[table["selected"], "seed"].iloc[0])
+    write_text_atomic(args.out / "selected_seed.txt", f"{chosen}\n")
+    print(table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+    print(f"selected seed {chosen}")
+
+
 def _bench_physics(args, cfg, started) -> None:
     from .bench.physics import bench_physics, format_physics
     from .io import write_run_metadata, write_text_atomic
@@ -138,11 +186,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     started = datetime.now(timezone.utc)
     try:
+        if args.command == "select":
+            _select(args, started)
+            return 0
         cfg = compose(args.overrides)
         if args.command == "config":
             print(to_yaml(cfg), end="")
         elif args.command == "train":
             _train(args, cfg, started)
+        elif args.command == "assay":
+            _assay(args, cfg, started)
         elif args.command == "plan":
             from .physics.plan import build_plan
 

@@ -67,3 +67,10 @@ def test_selection_ties_go_to_more_food():
 def test_missing_columns_are_named():
     with pytest.raises(ValueError, match="food_eaten"):
         seed_statistics(pd.DataFrame({"seed": [1], "episode": [0], "size": [0.5]}))
+
+
+def test_without_eligible_seeds_all_are_ranked_and_flagged():
+    stats = pd.DataFrame({"seed": [1, 2], "food_per_episode": [0.0, 1.0], "slope": [0.0, 0.5],
+                          "intercept": [0.0, -1.0], "r2": [0.0, 0.1], "episodes": [5, 5]})
+    table = rank_seeds(stats)
+    assert table["fallback"].all() and table.loc[0, "seed"] == 2 and table["selected"].sum() == 1

@@ -15,8 +15,8 @@ from efish.rollout.tables import write_tables
 class GreedyForward:
     """A scripted policy: full speed ahead, no turn, always emit, never bite."""
 
-    def initial_hidden(self, b):
-        return np.zeros((b, 1, 1), np.float32)
+    def initial_hidden(self, b, n=1):
+        return np.zeros((b, n, 1), np.float32)
 
     def act(self, obs, hidden, starts, deterministic=True):
         a = np.zeros(obs.shape[:2] + (4,))

@@ -41,10 +41,15 @@ def seed_statistics(episodes: pd.DataFrame) -> pd.DataFrame:
 
 
 def rank_seeds(stats: pd.DataFrame) -> pd.DataFrame:
-    """The full ranking table: eligible seeds ranked, the winner first, dropped seeds last."""
+    """The full ranking table: eligible seeds ranked, the winner first, dropped seeds last.
+
+    When no seed is eligible (e.g. untrained seeds that eat nothing, at smoke
+    scale), all are ranked and the winner is marked in a ``fallback`` column.
+    """
     table = stats.copy()
     table["eligible"] = table["intercept"] > 0
-    ok = table["eligible"]
+    table["fallback"] = not table["eligible"].any()
+    ok = table["eligible"] | table["fallback"]
     for col in ("food_per_episode", "slope", "r2"):
         table[f"rank_{col}"] = np.nan
         table.loc[ok, f"rank_{col}"] = table.loc[ok, col].rank(ascending=False, method="average")
@@ -52,6 +57,5 @@ def rank_seeds(stats: pd.DataFrame) -> pd.DataFrame:
     table = table.sort_values(["eligible", "rank_sum", "food_per_episode"], ascending=[False, True, False],
                               na_position="last").reset_index(drop=True)
     table["selected"] = False
-    if ok.any():
-        table.loc[0, "selected"] = True
+    table.loc[0, "selected"] = True
     return table

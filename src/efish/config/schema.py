@@ -228,6 +228,18 @@ class TrainConfig:
     seed: int = param(1, "training seed", lo=0)
 
 
+# ----------------------------------------------------------------------- assay
+@dataclass
+class AssayConfig:
+    """An evaluation assay (SPEC 11): which conditions, how many episodes, how to act."""
+
+    name: str = param("patchy4", "assay name, used in output paths")
+    episodes: int = param(30, "episodes per condition", lo=1)
+    seed: int = param(1000, "seed of the evaluation episodes (held out from training)", lo=0)
+    deterministic: bool = param(True, "thresholded EOD/bite and Gaussian means instead of samples")
+    conditions: dict = param({}, "condition name -> list of config overrides (set by each assay file)")
+
+
 # ----------------------------------------------------------------------- bench
 @dataclass
 class BenchConfig:
@@ -259,6 +271,7 @@ class EfishConfig:
     arena: ArenaConfig = group(ArenaConfig)
     env: EnvConfig = group(EnvConfig)
     train: TrainConfig = group(TrainConfig)
+    assay: AssayConfig = group(AssayConfig)
     bench: BenchConfig = group(BenchConfig)
     scale: ScaleConfig = group(ScaleConfig)
 
@@ -289,6 +302,8 @@ def validate(obj: Any, path: str = "") -> None:
 
 def _check_consistency(obj: Any, path: str) -> None:
     """Cross-field rules that a single range cannot express."""
+    if isinstance(obj, AssayConfig) and not obj.conditions:
+        raise ConfigError(f"{path}conditions is empty: an assay needs at least one condition")
     if isinstance(obj, TrainConfig) and obj.rollout_steps % obj.chunk:
         raise ConfigError(f"{path}chunk={obj.chunk} must divide {path}rollout_steps={obj.rollout_steps}")
     if isinstance(obj, EnvConfig):

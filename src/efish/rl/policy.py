@@ -21,16 +21,21 @@ class Policy:
         self.actor = actor.eval()
         self.n_agents = n_agents
         self.hidden_size = actor.trunk.hidden
+        self.obs_dim = actor.trunk.mlp[0].normalized_shape[0]
 
-    def initial_hidden(self, num_envs: int) -> np.ndarray:
-        return np.zeros((num_envs, self.n_agents, self.hidden_size), dtype=np.float32)
+    def initial_hidden(self, num_envs: int, n_agents: int | None = None) -> np.ndarray:
+        """Zero hidden states [B, N, H]; the shared weights act for any number of agents."""
+        return np.zeros((num_envs, n_agents or self.n_agents, self.hidden_size), dtype=np.float32)
 
     @torch.no_grad()
     def act(self, obs: np.ndarray, hidden: np.ndarray, starts: np.ndarray, deterministic: bool = True,
             generator: torch.Generator | None = None) -> tuple[np.ndarray, np.ndarray]:
         """obs [B, N, D], hidden [B, N, H], starts [B] or [B, N] (1 on an episode's first step) ->
         (actions [B, N, 4], hidden [B, N, H])."""
-        b, n, _ = obs.shape
+        b, n, d = obs.shape
+        if d != self.obs_dim:
+            raise ValueError(f"the policy expects observations of {self.obs_dim} values, the env gives {d} "
+                             "(another perception or agent count than in training?)")
         starts = np.broadcast_to(np.asarray(starts, dtype=np.float32).reshape(b, -1), (b, n))
         dist, h, _ = self.actor(torch.as_tensor(obs, dtype=torch.float32).reshape(1, b * n, -1),
                                 torch.as_tensor(hidden).reshape(b * n, -1),

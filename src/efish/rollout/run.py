@@ -42,12 +42,12 @@ def run_episodes(cfg: EfishConfig, policy, episodes: int, condition: str = "cont
                  deterministic: bool = True) -> dict[str, pd.DataFrame]:
     """``episodes`` episodes in parallel arenas; returns the ``steps``, ``episodes`` and ``food`` tables.
 
-    ``policy`` has ``initial_hidden(B)`` and ``act(obs, hidden, starts, deterministic)`` like
+    ``policy`` has ``initial_hidden(B, N)`` and ``act(obs, hidden, starts, deterministic)`` like
     :class:`efish.rl.policy.Policy`.
     """
     env = VecEnv(cfg, num_envs=episodes, seed=seed, autoreset=False)
     obs = env.reset()
-    hidden, starts = policy.initial_hidden(episodes), np.ones(episodes)
+    hidden, starts = policy.initial_hidden(episodes, env.n), np.ones(episodes)
     T, B, N = cfg.env.episode_steps, episodes, env.n
     sl = observation_slices(len(env.plan.morm_angles), len(env.plan.amp_angles), len(env.plan.knollen_angles),
                             cfg.env.obs_agents)
