@@ -86,7 +86,6 @@ def _train(args, cfg, started) -> None:
     from .rl.train import train
 
     out = args.out or Path(f"results/{cfg.scale.name}/train/seed_{cfg.train.seed}")
-    write_run_metadata(out, to_yaml(cfg), started)
     bar = None
     if sys.stderr.isatty():
         from tqdm import tqdm
@@ -137,7 +136,12 @@ def _select(args, started) -> None:
         m = re.search(r"seed_(\d+)", str(path))
         if not m:
             raise ValueError(f"cannot tell the seed of {path}: put it under a folder named seed_<n>")
-        frames.append(pd.read_parquet(path).assign(seed=int(m.group(1))))
+        try:
+            frames.append(pd.read_parquet(path).assign(seed=int(m.group(1))))
+        except OSError:
+            raise
+        except Exception as exc:  # pyarrow raises its own types for files that are not Parquet
+            raise ValueError(f"cannot read {path} as an episodes table: {type(exc).__name__}") from None
     table = rank_seeds(seed_statistics(pd.concat(frames, ignore_index=True)))
     if table["fallback"].any():
         print("efish: warning: no seed has a positive median intercept; ranked all seeds (fallback)", file=sys.stderr)

@@ -112,11 +112,11 @@ def collect(cfg: EfishConfig, env: VecEnv, learner: Learner, carry: dict, genera
 def train(cfg: EfishConfig, out_dir: str | Path, progress=None) -> pd.DataFrame:
     """Train one seed into ``out_dir`` (checkpoint.pt, metrics.parquet); resumes from a checkpoint there."""
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     t_cfg = cfg.train
     torch.set_num_threads(t_cfg.threads)
     env = VecEnv(cfg, num_envs=t_cfg.num_envs, seed=t_cfg.seed)
-    obs = env.reset()
+    obs = env.reset()  # bad env settings fail here, before anything is written
+    out.mkdir(parents=True, exist_ok=True)
     learner = Learner(cfg, obs.shape[-1], env.n)
     S, H = env.num_envs * env.n, t_cfg.hidden
     carry = {"obs": obs, "h_actor": torch.zeros(S, H), "h_critic": torch.zeros(S, H), "starts": torch.ones(S),
