@@ -8,6 +8,10 @@ min_version("9.0")
 
 include: "workflow/rules/common.smk"
 include: "workflow/rules/bench.smk"
+include: "workflow/rules/train.smk"
+include: "workflow/rules/select.smk"
+include: "workflow/rules/assays.smk"
+include: "workflow/rules/figures.smk"
 
 
 rule all:

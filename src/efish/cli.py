@@ -2,9 +2,10 @@
 
     efish config [overrides]                  print the resolved config
     efish plan [overrides]                    which effects run, and why
-    efish train [overrides] [--out D]         train one seed (checkpoint.pt, metrics.parquet)
+    efish train [overrides] [--out D]         train one seed (checkpoint.pt, metrics.parquet, final.pt)
     efish assay [overrides] --policy P        run an assay into steps/episodes/food.parquet
     efish select EPISODES... --out D          rank seeds, write the ranking and the chosen seed
+    efish figure FIG[/PANEL] [overrides]      draw a panel (or a figure's page) from the result tables
     efish bench physics [overrides] [--json]  sensing throughput, fast vs reference
     efish bench accuracy [overrides] --out D  accuracy-vs-time study -> table + figure
     efish bench env [overrides] [--json]      env-only throughput, fast vs reference physics
@@ -40,11 +41,16 @@ def _parser() -> argparse.ArgumentParser:
     tr.add_argument("--out", type=Path, help="output folder (default results/{scale}/train/seed_{seed})")
     asy = sub.add_parser("assay", help="run an assay with a trained policy into Parquet tables")
     asy.add_argument("overrides", nargs="*")
-    asy.add_argument("--policy", type=Path, required=True, help="training folder or checkpoint.pt")
+    asy.add_argument("--policy", type=Path, required=True, help="training folder, final.pt or checkpoint.pt")
     asy.add_argument("--out", type=Path, help="output folder (default results/{scale}/assays/{assay})")
     sel = sub.add_parser("select", help="rank seeds from their evaluation episodes (SPEC 10)")
     sel.add_argument("episodes", nargs="+", type=Path, help="episodes.parquet files in folders named seed_<n>")
     sel.add_argument("--out", type=Path, required=True, help="folder for ranking.parquet and selected_seed.txt")
+    fg = sub.add_parser("figure", help="draw a panel (fig3/M) or a whole figure's page (fig3) from the tables")
+    fg.add_argument("key", help="panel id like fig3/M, or a figure id like fig3 for its page")
+    fg.add_argument("overrides", nargs="*")
+    fg.add_argument("--results", type=Path, help="folder of the result tables (default results/{scale})")
+    fg.add_argument("--out", type=Path, help="folder for the figures (default figures/{scale})")
     b = sub.add_parser("bench", help="speed and accuracy studies")
     bsub = b.add_subparsers(dest="bench", required=True)
     bp = bsub.add_parser("physics", help="sensing throughput: fast path vs reference, one thread")
@@ -153,6 +159,22 @@ def _select(args, started) -> None:
     print(f"selected seed {chosen}")
 
 
+def _figure(args, cfg) -> None:
+    from .figures.registry import figures, panels_for
+    from .figures.render import render_page, render_panel
+
+    results = args.results or Path(f"results/{cfg.scale.name}")
+    out = args.out or Path(f"figures/{cfg.scale.name}")
+    if "/" in args.key:
+        written = render_panel(args.key, results, out, cfg.scale.seeds)
+    else:
+        if args.key not in figures():
+            raise ValueError(f"unknown figure {args.key!r}: choose one of {', '.join(figures())}")
+        drawable = [p for p in panels_for(cfg.scale.assays) if p.figure == args.key]
+        written = render_page(args.key, drawable, results, out, cfg.scale.seeds)
+    print("wrote " + ", ".join(map(str, written)))
+
+
 def _bench_physics(args, cfg, started) -> None:
     from .bench.physics import bench_physics, format_physics
     from .io import write_run_metadata, write_text_atomic
@@ -200,6 +222,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             _train(args, cfg, started)
         elif args.command == "assay":
             _assay(args, cfg, started)
+        elif args.command == "figure":
+            _figure(args, cfg)
         elif args.command == "plan":
             from .physics.plan import build_plan
 

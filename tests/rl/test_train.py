@@ -8,7 +8,7 @@ import pytest
 import torch
 
 from efish.config import compose
-from efish.rl.train import CHECKPOINT, METRICS, train
+from efish.rl.train import CHECKPOINT, FINAL, METRICS, train
 
 TINY = ["env=homing", "arena=uniform70", "arena.width_cm=30", "arena.height_cm=30", "arena.layout=none",
         "env.episode_steps=20", "train.hidden=16", "train.num_envs=2", "train.rollout_steps=20", "train.chunk=5",
@@ -26,6 +26,7 @@ def weights(path):
 def test_training_writes_metrics_and_checkpoint(tmp_path):
     df = train(tiny(2), tmp_path)
     assert list(df["update"]) == [1, 2] and (tmp_path / CHECKPOINT).exists()
+    assert (tmp_path / FINAL).read_bytes() == (tmp_path / CHECKPOINT).read_bytes()
     stored = pd.read_parquet(tmp_path / METRICS)
     for col in ("env_steps", "wall_s", "episode_return", "reward_home", "policy_loss", "value_loss", "entropy",
                 "approx_kl", "clip_fraction", "explained_variance", "env_steps_per_s"):

@@ -1,18 +1,68 @@
-# Shared settings and target lists.
-SCALES = ["smoke", "laptop", "paper"]
-SCALE = config.get("scale", "laptop")
-if SCALE not in SCALES:
-    raise ValueError(f"unknown scale {SCALE!r}: choose one of {', '.join(SCALES)}")
+# Shared settings: the scale and its efish config, read once. Every number the
+# rules need (seeds, assays, panels) comes from efish's config; none is repeated here.
+import shlex
+from pathlib import Path
+
+from snakemake.exceptions import WorkflowError
+
+from efish.config import ConfigError, compose, config_dir
+from efish.figures.registry import PANELS, figures, panels_for
+
+SCALE = str(config.get("scale", "laptop"))
+# Extra Hydra overrides for every efish call, e.g. --config overrides="physics.tolerance=1e-6"
+OVERRIDES = shlex.split(str(config.get("overrides", "")))
+
+
+def efish_config(*overrides):
+    """The validated efish config at this scale with the user's overrides; bad input stops the workflow
+    before any job runs, with efish's one-line message."""
+    try:
+        return compose([f"scale={SCALE}", *OVERRIDES, *overrides])
+    except ConfigError as exc:
+        raise WorkflowError(f"efish config: {exc}") from None
+
+
+CFG = efish_config()
+SEEDS = list(range(1, CFG.scale.seeds + 1))
+ARGS = " ".join(shlex.quote(o) for o in OVERRIDES)  # passed on to every efish call
+
+
+def assay_config(name):
+    """The composed config of assay ``name``; an assay without a config file is one clear error."""
+    if not (config_dir() / "assay" / f"{name}.yaml").is_file():
+        known = sorted(p.stem for p in (config_dir() / "assay").glob("*.yaml"))
+        raise WorkflowError(f"unknown assay {name!r}: add config/assay/{name}.yaml or choose one of {', '.join(known)}")
+    return efish_config(f"assay={name}")
+
+
+ASSAYS = [assay_config(name).assay.name for name in CFG.scale.assays]
+DRAWABLE = panels_for(ASSAYS)
 
 
 wildcard_constraints:
-    scale="|".join(SCALES),
+    scale=SCALE,
+    seed=r"\d+",
+    assay=r"[A-Za-z0-9_\-]+",
+
+
+def panel_inputs(panel):
+    """Every table a panel reads, at this scale."""
+    paths = []
+    for path in panel.inputs.values():
+        rels = [path.format(seed=s) for s in SEEDS] if "{seed}" in path else [path]
+        paths += [f"results/{SCALE}/{rel}" for rel in rels]
+    return paths
 
 
 def all_targets():
     """Every final output of the pipeline at the chosen scale."""
-    return [
+    targets = [
         f"results/{SCALE}/bench/bench_physics.json",
         f"results/{SCALE}/bench/bench_accuracy.parquet",
         f"figures/{SCALE}/bench/bench_accuracy.png",
     ]
+    targets += [f"results/{SCALE}/assays/{a}/{t}.parquet" for a in ASSAYS for t in ("steps", "episodes", "food")]
+    targets += [f"figures/{SCALE}/{p.figure}/{p.name}.{ext}" for p in DRAWABLE for ext in ("png", "pdf")]
+    pages = {p.figure for p in DRAWABLE}
+    targets += [f"figures/{SCALE}/{fig}.{ext}" for fig in sorted(pages) for ext in ("png", "pdf")]
+    return targets

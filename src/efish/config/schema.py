@@ -237,6 +237,8 @@ class AssayConfig:
     episodes: int = param(30, "episodes per condition", lo=1)
     seed: int = param(1000, "seed of the evaluation episodes (held out from training)", lo=0)
     deterministic: bool = param(True, "thresholded EOD/bite and Gaussian means instead of samples")
+    policy: str = param("selected", "which trained policy acts: the selected foraging seed or the homing policy",
+                        choices=("selected", "homing"))
     conditions: dict = param({}, "condition name -> list of config overrides (set by each assay file)")
 
 
@@ -260,6 +262,18 @@ class ScaleConfig:
     """How big a run is: laptop, smoke or paper."""
 
     name: str = param("laptop", "name of the scale, used in output paths")
+    seeds: int = param(4, "foraging seeds trained (1..seeds)", lo=1)
+    hidden: int = param(64, "network width (train.hidden reads it)", lo=1, hi=8192)
+    num_envs: int = param(8, "parallel arenas per rollout (train.num_envs reads it)", lo=1)
+    rollout_steps: int = param(400, "steps per foraging rollout (train.rollout_steps reads it)", lo=1)
+    chunk: int = param(50, "foraging BPTT chunk (train.chunk reads it)", lo=1)
+    epochs: int = param(15, "PPO epochs per update (train.epochs reads it)", lo=1)
+    train_steps: int = param(240_000, "foraging env steps per seed", lo=1)
+    homing_steps: int = param(120_000, "homing env steps", lo=1)
+    homing_rollout_steps: int = param(800, "steps per homing rollout", lo=1)
+    max_episodes: int = param(8, "cap on the episodes per assay condition (SPEC 11 counts at paper scale)", lo=1)
+    selection_episodes: int = param(8, "patchy4 episodes per seed for seed selection (SPEC 10)", lo=1)
+    assays: list = param(["patchy4", "homing"], "assays the pipeline runs (names of config/assay/*.yaml)")
 
 
 @dataclass

@@ -8,7 +8,7 @@ import numpy as np
 import torch
 
 from .networks import Actor
-from .train import CHECKPOINT
+from .train import CHECKPOINT, FINAL
 
 
 class Policy:
@@ -45,10 +45,10 @@ class Policy:
 
 
 def load_policy(path: str | Path) -> Policy:
-    """The actor of a checkpoint (a file, or a training folder holding checkpoint.pt)."""
+    """The actor of a checkpoint: a file, or a training folder (its final.pt, else its latest checkpoint.pt)."""
     path = Path(path)
     if path.is_dir():
-        path = path / CHECKPOINT
+        path = path / FINAL if (path / FINAL).exists() else path / CHECKPOINT
     try:
         state = torch.load(path, weights_only=False)
         arch = state["architecture"]

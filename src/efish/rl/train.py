@@ -9,6 +9,7 @@ uninterrupted one.
 
 from __future__ import annotations
 
+import shutil
 import time
 from pathlib import Path
 
@@ -25,6 +26,7 @@ from .networks import Actor, Critic
 from .value_norm import ValueNormalizer
 
 CHECKPOINT = "checkpoint.pt"
+FINAL = "final.pt"  # the finished run: what the pipeline declares as the training output
 METRICS = "metrics.parquet"
 
 
@@ -110,7 +112,8 @@ def collect(cfg: EfishConfig, env: VecEnv, learner: Learner, carry: dict, genera
 
 
 def train(cfg: EfishConfig, out_dir: str | Path, progress=None) -> pd.DataFrame:
-    """Train one seed into ``out_dir`` (checkpoint.pt, metrics.parquet); resumes from a checkpoint there."""
+    """Train one seed into ``out_dir`` (checkpoint.pt, metrics.parquet, and final.pt at the end); resumes from a
+    checkpoint there."""
     out = Path(out_dir)
     t_cfg = cfg.train
     torch.set_num_threads(t_cfg.threads)
@@ -143,6 +146,10 @@ def train(cfg: EfishConfig, out_dir: str | Path, progress=None) -> pd.DataFrame:
             save_checkpoint(out / CHECKPOINT, learner, env, carry, generator, update, rows)
             with atomic_path(out / METRICS) as tmp:
                 pd.DataFrame(rows).to_parquet(tmp, index=False)
+    # Written once, atomically, after the last update: a killed job never leaves a final.pt, so the
+    # workflow reruns it and the rerun resumes from checkpoint.pt instead of starting over.
+    with atomic_path(out / FINAL) as tmp:
+        shutil.copyfile(out / CHECKPOINT, tmp)
     return pd.DataFrame(rows)
 
 

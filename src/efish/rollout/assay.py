@@ -12,11 +12,13 @@ from .run import run_episodes
 
 def run_assay(overrides: Sequence[str], policy) -> dict[str, pd.DataFrame]:
     """Compose the assay's config with ``overrides``, run each condition (its own overrides on top)
-    for ``assay.episodes`` episodes, and return the concatenated ``steps``, ``episodes``, ``food`` tables."""
+    for ``min(assay.episodes, scale.max_episodes)`` episodes, and return the concatenated ``steps``,
+    ``episodes``, ``food`` tables."""
     base = compose(list(overrides))
     parts = []
     for name, extra in base.assay.conditions.items():
         cfg = compose(list(overrides) + list(extra))
-        parts.append(run_episodes(cfg, policy, cfg.assay.episodes, condition=name, seed=cfg.assay.seed,
+        episodes = min(cfg.assay.episodes, cfg.scale.max_episodes)
+        parts.append(run_episodes(cfg, policy, episodes, condition=name, seed=cfg.assay.seed,
                                   deterministic=cfg.assay.deterministic))
     return {k: pd.concat([p[k] for p in parts], ignore_index=True) for k in parts[0]}

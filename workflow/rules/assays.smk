@@ -1,0 +1,30 @@
+# Assays (SPEC 11): one job per assay writes its steps, episodes and food tables.
+# An assay is a file config/assay/<name>.yaml; its `policy` key says which
+# trained policy acts (the selected seed, or the homing policy).
+
+
+def assay_policy(wildcards):
+    if assay_config(wildcards.assay).assay.policy == "homing":
+        return f"results/{wildcards.scale}/train/homing/final.pt"
+    return selected_policy(wildcards)
+
+
+rule assay:
+    input:
+        policy=assay_policy,
+    output:
+        steps="results/{scale}/assays/{assay}/steps.parquet",
+        episodes="results/{scale}/assays/{assay}/episodes.parquet",
+        food="results/{scale}/assays/{assay}/food.parquet",
+    log:
+        "results/{scale}/logs/assays/{assay}.log",
+    benchmark:
+        "results/{scale}/benchmarks/assays/{assay}.tsv"
+    params:
+        overrides=ARGS,
+    threads: 1
+    conda:
+        "../envs/efish.yaml"
+    shell:
+        "efish assay assay={wildcards.assay} scale={wildcards.scale} {params.overrides} --policy {input.policy} "
+        "--out results/{wildcards.scale}/assays/{wildcards.assay} > {log} 2>&1"

@@ -1,0 +1,55 @@
+# Panels: one job per registered panel (efish.figures.registry), one page per figure.
+
+
+def panel_of(wildcards):
+    key = f"{wildcards.figure}/{wildcards.panel}"
+    if key not in PANELS:
+        raise WorkflowError(f"unknown panel {key!r}: choose one of {', '.join(PANELS)}")
+    return PANELS[key]
+
+
+rule panel:
+    input:
+        lambda w: panel_inputs(panel_of(w)),
+    output:
+        png=report(
+            "figures/{scale}/{figure}/{panel}.png",
+            caption="../report/panel.rst",
+            category="{figure}",
+        ),
+        pdf="figures/{scale}/{figure}/{panel}.pdf",
+    log:
+        "results/{scale}/logs/figures/{figure}_{panel}.log",
+    benchmark:
+        "results/{scale}/benchmarks/figures/{figure}_{panel}.tsv"
+    params:
+        overrides=ARGS,
+        caption=lambda w: panel_of(w).caption,
+    wildcard_constraints:
+        figure="fig[0-9]+|supp",
+    conda:
+        "../envs/efish.yaml"
+    shell:
+        "efish figure {wildcards.figure}/{wildcards.panel} scale={wildcards.scale} {params.overrides} "
+        "--results results/{wildcards.scale} --out figures/{wildcards.scale} > {log} 2>&1"
+
+
+rule figure_page:
+    input:
+        lambda w: [path for p in DRAWABLE if p.figure == w.figure for path in panel_inputs(p)],
+    output:
+        png="figures/{scale}/{figure}.png",
+        pdf="figures/{scale}/{figure}.pdf",
+    log:
+        "results/{scale}/logs/figures/{figure}.log",
+    benchmark:
+        "results/{scale}/benchmarks/figures/{figure}.tsv"
+    params:
+        overrides=ARGS,
+    wildcard_constraints:
+        figure="fig[0-9]+|supp",
+    conda:
+        "../envs/efish.yaml"
+    shell:
+        "efish figure {wildcards.figure} scale={wildcards.scale} {params.overrides} "
+        "--results results/{wildcards.scale} --out figures/{wildcards.scale} > {log} 2>&1"

@@ -1,0 +1,46 @@
+# Seed selection (SPEC 10): every seed on held-out patchy episodes, then a
+# checkpoint rule ranks them; the assays read the chosen seed from its output.
+
+
+rule evaluate_seed:
+    input:
+        "results/{scale}/train/seed_{seed}/final.pt",
+    output:
+        "results/{scale}/selection/seed_{seed}/episodes.parquet",
+        "results/{scale}/selection/seed_{seed}/steps.parquet",
+        "results/{scale}/selection/seed_{seed}/food.parquet",
+    log:
+        "results/{scale}/logs/selection/seed_{seed}.log",
+    benchmark:
+        "results/{scale}/benchmarks/selection/seed_{seed}.tsv"
+    params:
+        overrides=ARGS,
+    threads: 1
+    conda:
+        "../envs/efish.yaml"
+    shell:
+        "efish assay assay=selection scale={wildcards.scale} {params.overrides} --policy {input} "
+        "--out results/{wildcards.scale}/selection/seed_{wildcards.seed} > {log} 2>&1"
+
+
+checkpoint select_seed:
+    input:
+        expand("results/{{scale}}/selection/seed_{seed}/episodes.parquet", seed=SEEDS),
+    output:
+        ranking="results/{scale}/analysis/selection/ranking.parquet",
+        seed="results/{scale}/analysis/selection/selected_seed.txt",
+    log:
+        "results/{scale}/logs/select_seed.log",
+    benchmark:
+        "results/{scale}/benchmarks/select_seed.tsv"
+    conda:
+        "../envs/efish.yaml"
+    shell:
+        "efish select {input} --out results/{wildcards.scale}/analysis/selection > {log} 2>&1"
+
+
+def selected_policy(wildcards):
+    """The final checkpoint of the seed the select_seed checkpoint chose."""
+    chosen = checkpoints.select_seed.get(scale=wildcards.scale).output.seed
+    seed = int(Path(chosen).read_text().strip())
+    return f"results/{wildcards.scale}/train/seed_{seed}/final.pt"

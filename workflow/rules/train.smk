@@ -1,0 +1,39 @@
+# Training: every foraging seed of the scale, and the homing policy. efish train
+# checkpoints beside the declared output and writes final.pt atomically at the
+# end, so a killed job is rerun and resumes from its last checkpoint.
+
+
+rule train:
+    output:
+        final="results/{scale}/train/seed_{seed}/final.pt",
+        metrics="results/{scale}/train/seed_{seed}/metrics.parquet",
+    log:
+        "results/{scale}/logs/train/seed_{seed}.log",
+    benchmark:
+        "results/{scale}/benchmarks/train/seed_{seed}.tsv"
+    params:
+        overrides=ARGS,
+    threads: 1
+    conda:
+        "../envs/efish.yaml"
+    shell:
+        "efish train scale={wildcards.scale} train.seed={wildcards.seed} train.threads={threads} "
+        "{params.overrides} --out results/{wildcards.scale}/train/seed_{wildcards.seed} > {log} 2>&1"
+
+
+rule train_homing:
+    output:
+        final="results/{scale}/train/homing/final.pt",
+        metrics="results/{scale}/train/homing/metrics.parquet",
+    log:
+        "results/{scale}/logs/train/homing.log",
+    benchmark:
+        "results/{scale}/benchmarks/train/homing.tsv"
+    params:
+        overrides=ARGS,
+    threads: 1
+    conda:
+        "../envs/efish.yaml"
+    shell:
+        "efish train scale={wildcards.scale} train=homing env=homing arena=homing_train train.threads={threads} "
+        "{params.overrides} --out results/{wildcards.scale}/train/homing > {log} 2>&1"
