@@ -4,7 +4,7 @@
     efish plan [overrides]                    which effects run, and why
     efish train [overrides] [--out D]         train one seed (checkpoint.pt, metrics.parquet, final.pt)
     efish assay [overrides] --policy P        run an assay into steps/episodes/food.parquet
-    efish select EPISODES... --out D          rank seeds, write the ranking and the chosen seed
+    efish select --episodes F... --out D      rank seeds, write the ranking and the chosen seed
     efish figure FIG[/PANEL] [overrides]      draw a panel (or a figure's page) from the result tables
     efish bench physics [overrides] [--json]  sensing throughput, fast vs reference
     efish bench accuracy [overrides] --out D  accuracy-vs-time study -> table + figure
@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import logging
 import sys
 from datetime import datetime, timezone
 from pathlib import Path
@@ -44,7 +45,9 @@ def _parser() -> argparse.ArgumentParser:
     asy.add_argument("--policy", type=Path, required=True, help="training folder, final.pt or checkpoint.pt")
     asy.add_argument("--out", type=Path, help="output folder (default results/{scale}/assays/{assay})")
     sel = sub.add_parser("select", help="rank seeds from their evaluation episodes (SPEC 10)")
-    sel.add_argument("episodes", nargs="+", type=Path, help="episodes.parquet files in folders named seed_<n>")
+    sel.add_argument("overrides", nargs="*", help="config overrides, recorded in config.yaml (e.g. scale=laptop)")
+    sel.add_argument("--episodes", nargs="+", type=Path, required=True,
+                     help="episodes.parquet files in folders named seed_<n>")
     sel.add_argument("--out", type=Path, required=True, help="folder for ranking.parquet and selected_seed.txt")
     fg = sub.add_parser("figure", help="draw a panel (fig3/M) or a whole figure's page (fig3) from the tables")
     fg.add_argument("key", help="panel id like fig3/M, or a figure id like fig3 for its page")
@@ -129,13 +132,13 @@ def _assay(args, cfg, started) -> None:
     print(f"wrote {', '.join(f'{k}.parquet ({len(v)} rows)' for k, v in tables.items())} to {out}")
 
 
-def _select(args, started) -> None:
+def _select(args, cfg, started) -> None:
     import re
 
     import pandas as pd
 
     from .analysis.selection import rank_seeds, seed_statistics
-    from .io import atomic_path, write_text_atomic
+    from .io import atomic_path, write_run_metadata, write_text_atomic
 
     frames = []
     for path in args.episodes:
@@ -155,13 +158,15 @@ def _select(args, started) -> None:
         table.to_parquet(tmp, index=False)
     chosen = int(table.loc[table["selected"], "seed"].iloc[0])
     write_text_atomic(args.out / "selected_seed.txt", f"{chosen}\n")
+    write_run_metadata(args.out, to_yaml(cfg), started, {"episodes": [str(p) for p in args.episodes]})
     print(table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
     print(f"selected seed {chosen}")
 
 
-def _figure(args, cfg) -> None:
+def _figure(args, cfg, started) -> None:
     from .figures.registry import figures, panels_for
     from .figures.render import render_page, render_panel
+    from .io import write_run_metadata
 
     results = args.results or Path(f"results/{cfg.scale.name}")
     out = args.out or Path(f"figures/{cfg.scale.name}")
@@ -172,6 +177,7 @@ def _figure(args, cfg) -> None:
             raise ValueError(f"unknown figure {args.key!r}: choose one of {', '.join(figures())}")
         drawable = [p for p in panels_for(cfg.scale.assays) if p.figure == args.key]
         written = render_page(args.key, drawable, results, out, cfg.scale.seeds)
+    write_run_metadata(written[0].parent, to_yaml(cfg), started, {"figure": args.key, "results": str(results)})
     print("wrote " + ", ".join(map(str, written)))
 
 
@@ -210,20 +216,20 @@ def _bench_accuracy(args, cfg, started) -> None:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``efish`` console script."""
     args = _parser().parse_args(argv)
+    logging.basicConfig(level=logging.INFO, format="efish: %(message)s", stream=sys.stderr)
     started = datetime.now(timezone.utc)
     try:
-        if args.command == "select":
-            _select(args, started)
-            return 0
         cfg = compose(args.overrides)
-        if args.command == "config":
+        if args.command == "select":
+            _select(args, cfg, started)
+        elif args.command == "config":
             print(to_yaml(cfg), end="")
         elif args.command == "train":
             _train(args, cfg, started)
         elif args.command == "assay":
             _assay(args, cfg, started)
         elif args.command == "figure":
-            _figure(args, cfg)
+            _figure(args, cfg, started)
         elif args.command == "plan":
             from .physics.plan import build_plan
 

@@ -36,7 +36,7 @@ def test_assay_and_select_commands_write_their_outputs(policy_dir, tmp_path):
                      "--policy", str(policy_dir), "--out", str(tmp_path / f"seed_{seed}")]) == 0
         assert (tmp_path / f"seed_{seed}" / "provenance.json").exists()
     files = [str(tmp_path / f"seed_{s}" / "episodes.parquet") for s in (1, 2)]
-    assert main(["select", *files, "--out", str(tmp_path / "select")]) == 0
+    assert main(["select", "--episodes", *files, "--out", str(tmp_path / "select")]) == 0
     ranking = pd.read_parquet(tmp_path / "select" / "ranking.parquet")
     assert ranking["selected"].sum() == 1
     assert (tmp_path / "select" / "selected_seed.txt").read_text().strip() in {"1", "2"}

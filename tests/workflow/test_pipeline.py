@@ -3,14 +3,20 @@
 from __future__ import annotations
 
 import json
+import os
+import re
 import shutil
+import signal
 import subprocess
+import time
 from pathlib import Path
 
 import pandas as pd
 import pytest
 
+from efish.analysis.selection import RANKING_COLUMNS
 from efish.bench.accuracy import COLUMNS
+from efish.rollout.schema import SCHEMAS, check_file
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -25,16 +31,101 @@ def smoke_run(tmp_path_factory) -> Path:
     result = subprocess.run(
         ["snakemake", "--cores", "2", "--config", "scale=smoke", "--directory", str(work),
          "--snakefile", str(work / "Snakefile")],
-        capture_output=True, text=True, timeout=900, env={**__import__("os").environ, "EFISH_CONFIG_DIR": str(work / "config")})
+        capture_output=True, text=True, timeout=900, env=smoke_env(work))
     assert result.returncode == 0, result.stderr[-3000:]
     return work
 
 
+def declared_outputs(work: Path) -> list[str]:
+    """Every output file of the smoke DAG, as Snakemake itself lists them."""
+    result = subprocess.run(["snakemake", "--config", "scale=smoke", "--summary", "--directory", str(work),
+                             "--snakefile", str(work / "Snakefile")], capture_output=True, text=True, timeout=300,
+                            env=smoke_env(work))
+    assert result.returncode == 0, result.stderr[-2000:]
+    return [line.split("\t")[0] for line in result.stdout.splitlines()[1:] if line.strip()]
+
+
 def test_every_declared_output_exists(smoke_run):
-    for rel in ("results/smoke/bench/bench_physics.json", "results/smoke/bench/bench_accuracy.parquet",
-                "results/smoke/bench/bench_accuracy.png", "figures/smoke/bench/bench_accuracy.png",
-                "results/smoke/bench/config.yaml", "results/smoke/bench/provenance.json"):
-        assert (smoke_run / rel).is_file(), rel
+    outputs = declared_outputs(smoke_run)
+    for part in ("train/seed_1/final.pt", "train/seed_2/final.pt", "train/homing/final.pt",
+                 "analysis/selection/ranking.parquet", "assays/patchy4/steps.parquet",
+                 "assays/homing/episodes.parquet"):
+        assert f"results/smoke/{part}" in outputs, part
+    assert any(o.startswith("figures/smoke/fig3/") for o in outputs)
+    missing = [o for o in outputs if not (smoke_run / o).is_file()]
+    assert not missing
+
+
+def test_every_table_matches_its_schema(smoke_run):
+    tables = list((smoke_run / "results/smoke").glob("**/*.parquet"))
+    checked = 0
+    for path in tables:
+        if path.stem in SCHEMAS:
+            check_file(path, path.stem)
+            checked += 1
+    assert checked >= 3 * (2 + 2)  # two assays and two seed evaluations, three tables each
+    ranking = pd.read_parquet(smoke_run / "results/smoke/analysis/selection/ranking.parquet")
+    assert list(ranking.columns) == list(RANKING_COLUMNS)
+    assert sorted(ranking["seed"]) == [1, 2] and ranking["selected"].sum() == 1
+    chosen = int((smoke_run / "results/smoke/analysis/selection/selected_seed.txt").read_text())
+    assert chosen == int(ranking.loc[ranking["selected"], "seed"].iloc[0])
+
+
+def test_every_output_folder_has_config_and_provenance(smoke_run):
+    folders = {p.parent for p in (smoke_run / "results/smoke").glob("**/*.parquet")}
+    folders |= {p.parent for p in (smoke_run / "figures/smoke").glob("*/*.png")}
+    folders.discard(smoke_run / "figures/smoke/bench")  # a copy of results/smoke/bench's figure
+    for folder in folders:
+        assert (folder / "config.yaml").is_file(), folder
+        prov = json.loads((folder / "provenance.json").read_text())
+        assert prov["command"] and prov["finished"] >= prov["started"], folder
+        assert "name: smoke" in (folder / "config.yaml").read_text(), folder
+
+
+def test_the_recorded_command_reproduces_an_assay(smoke_run, tmp_path):
+    """The provenance's command, rerun elsewhere, gives the same config and the same tables."""
+    folder = smoke_run / "results/smoke/assays/patchy4"
+    command = json.loads((folder / "provenance.json").read_text())["command"]
+    args = command[1:]
+    out = args.index("--out")
+    args[out + 1] = str(tmp_path / "again")
+    policy = args.index("--policy")
+    args[policy + 1] = str(smoke_run / args[policy + 1])
+    result = subprocess.run(["efish", *args], capture_output=True, text=True, timeout=300, env=smoke_env(smoke_run))
+    assert result.returncode == 0, result.stderr
+    assert (tmp_path / "again/config.yaml").read_text() == (folder / "config.yaml").read_text()
+    for name in ("steps", "episodes", "food"):
+        pd.testing.assert_frame_equal(pd.read_parquet(tmp_path / f"again/{name}.parquet"),
+                                      pd.read_parquet(folder / f"{name}.parquet"))
+
+
+def test_overrides_reach_every_efish_call(tmp_path):
+    result = dry_run(tmp_path, "--config", "scale=smoke", "overrides=physics.tolerance=1e-6 train.lr=1e-3",
+                     "--printshellcmds")
+    assert result.returncode == 0, result.stderr[-2000:]
+    calls = [line for line in result.stdout.splitlines() if line.startswith("efish ")]
+    assert calls and all("physics.tolerance=1e-6 train.lr=1e-3" in call for call in calls if " bench " not in call)
+
+
+@pytest.mark.parametrize("config, target, message", [
+    (["overrides=physics.tolerance=-1"], [], "efish config: physics.tolerance=-1.0 is out of range"),
+    (["overrides=physics.nonsense=1"], [], "efish config: unknown config key 'physics.nonsense'"),
+    ([], ["results/smoke/assays/nope/steps.parquet"], "unknown assay 'nope'"),
+])
+def test_bad_input_fails_before_any_job(tmp_path, config, target, message):
+    result = dry_run(tmp_path, "--config", "scale=smoke", *config, *target)
+    assert result.returncode != 0
+    assert message in result.stdout + result.stderr
+    assert not (tmp_path / "results").exists()
+
+
+def dry_run(work: Path, *args: str) -> subprocess.CompletedProcess:
+    return subprocess.run(["snakemake", "-n", "--cores", "1", "--snakefile", str(REPO / "Snakefile"),
+                           "--directory", str(work), *args], capture_output=True, text=True, timeout=300)
+
+
+def smoke_env(work: Path) -> dict:
+    return {**os.environ, "EFISH_CONFIG_DIR": str(work / "config")}
 
 
 def test_accuracy_table_matches_its_schema(smoke_run):
@@ -57,8 +148,7 @@ def test_scale_is_recorded_in_the_resolved_config(smoke_run):
 
 
 def test_unknown_scale_fails_before_any_job(tmp_path):
-    result = subprocess.run(["snakemake", "-n", "--cores", "1", "--config", "scale=huge", "--snakefile",
-                             str(REPO / "Snakefile"), "--directory", str(tmp_path)], capture_output=True, text=True)
+    result = dry_run(tmp_path, "--config", "scale=huge")
     assert result.returncode != 0
     assert "unknown scale 'huge'" in result.stdout + result.stderr
 
@@ -75,3 +165,31 @@ def test_report_renders_after_a_smoke_run(smoke_run):
                             capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr[-2000:]
     assert (smoke_run / "report.html").stat().st_size > 10_000
+
+
+def test_a_killed_training_job_resumes_from_its_checkpoint(tmp_path):
+    """Interrupt the pipeline mid-training; the rerun continues the seed from its last checkpoint."""
+    for name in ("Snakefile", "workflow", "config"):
+        src = REPO / name
+        (shutil.copytree if src.is_dir() else shutil.copy)(src, tmp_path / name)
+    seed_dir = tmp_path / "results/smoke/train/seed_1"
+    command = ["snakemake", "--cores", "1", "--rerun-incomplete", "--directory", str(tmp_path), "--snakefile",
+               str(tmp_path / "Snakefile"), "--config", "scale=smoke",
+               "overrides=scale.train_steps=20000 train.checkpoint_every=1", "results/smoke/train/seed_1/final.pt"]
+    first = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True,
+                             env=smoke_env(tmp_path))
+    deadline = time.monotonic() + 240
+    while not (seed_dir / "checkpoint.pt").exists() and time.monotonic() < deadline and first.poll() is None:
+        time.sleep(0.2)
+    time.sleep(1.0)
+    os.killpg(first.pid, signal.SIGINT)  # what Ctrl-C does
+    first.wait(timeout=120)
+    assert (seed_dir / "checkpoint.pt").exists() and not (seed_dir / "final.pt").exists()
+
+    second = subprocess.run(command, capture_output=True, text=True, timeout=600, env=smoke_env(tmp_path))
+    assert second.returncode == 0, second.stderr[-2000:]
+    log = (tmp_path / "results/smoke/logs/train/seed_1.log").read_text()
+    resumed = re.search(r"resumed from .* at update (\d+)", log)
+    assert resumed and int(resumed.group(1)) >= 1, log[-2000:]
+    metrics = pd.read_parquet(seed_dir / "metrics.parquet")
+    assert list(metrics["update"]) == list(range(1, 201))  # nothing lost, nothing repeated

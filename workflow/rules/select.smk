@@ -33,10 +33,12 @@ checkpoint select_seed:
         "results/{scale}/logs/select_seed.log",
     benchmark:
         "results/{scale}/benchmarks/select_seed.tsv"
+    params:
+        overrides=ARGS,
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish select {input} --out results/{wildcards.scale}/analysis/selection > {log} 2>&1"
+        "efish select scale={wildcards.scale} {params.overrides} --episodes {input} --out results/{wildcards.scale}/analysis/selection > {log} 2>&1"
 
 
 def selected_policy(wildcards):

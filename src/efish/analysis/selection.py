@@ -40,6 +40,10 @@ def seed_statistics(episodes: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+RANKING_COLUMNS = ("seed", "food_per_episode", "slope", "intercept", "r2", "episodes", "eligible", "fallback",
+                   "rank_food_per_episode", "rank_slope", "rank_r2", "rank_sum", "selected")
+
+
 def rank_seeds(stats: pd.DataFrame) -> pd.DataFrame:
     """The full ranking table: eligible seeds ranked, the winner first, dropped seeds last.
 
@@ -58,4 +62,4 @@ def rank_seeds(stats: pd.DataFrame) -> pd.DataFrame:
                               na_position="last").reset_index(drop=True)
     table["selected"] = False
     table.loc[0, "selected"] = True
-    return table
+    return table[list(RANKING_COLUMNS)]

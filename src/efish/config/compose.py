@@ -86,6 +86,11 @@ def one_line_message(exc: BaseException) -> str:
     lines = [ln.strip() for ln in text.splitlines() if ln.strip()]
     if "is not in struct" in text or "Key '" in text and "not in" in text:
         return f"unknown config key '{name.group(1) if name else '?'}'"
+    option = re.search(r"Could not find '(\w+)/([^']+)'", text)
+    if option is not None:
+        group, choice = option.groups()
+        known = sorted(p.stem for p in (config_dir() / group).glob("*.yaml"))
+        return f"unknown {group} {choice!r}: choose one of {', '.join(known)} (files in config/{group}/)"
     if "Could not find" in text and "config" in text.lower():
         return lines[0]
     if name is not None:

@@ -9,6 +9,7 @@ uninterrupted one.
 
 from __future__ import annotations
 
+import logging
 import shutil
 import time
 from pathlib import Path
@@ -26,6 +27,7 @@ from .networks import Actor, Critic
 from .value_norm import ValueNormalizer
 
 CHECKPOINT = "checkpoint.pt"
+LOG = logging.getLogger(__name__)
 FINAL = "final.pt"  # the finished run: what the pipeline declares as the training output
 METRICS = "metrics.parquet"
 
@@ -128,6 +130,8 @@ def train(cfg: EfishConfig, out_dir: str | Path, progress=None) -> pd.DataFrame:
     rows, update = [], 0
     if (out / CHECKPOINT).exists():
         update, rows = load_checkpoint(out / CHECKPOINT, learner, env, carry, generator)
+        LOG.info("resumed from %s at update %d (%d env steps)", out / CHECKPOINT, update,
+                 update * t_cfg.rollout_steps * t_cfg.num_envs)
     steps_per_update = t_cfg.rollout_steps * t_cfg.num_envs
     total_updates = max(1, t_cfg.total_steps // steps_per_update)
     start = time.perf_counter()
