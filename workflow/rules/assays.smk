@@ -3,12 +3,6 @@
 # trained policy acts (the selected seed, or the homing policy).
 
 
-def assay_policy(wildcards):
-    if assay_config(wildcards.assay).assay.policy == "homing":
-        return f"results/{wildcards.scale}/train/homing/final.pt"
-    return selected_policy(wildcards)
-
-
 rule assay:
     input:
         policy=assay_policy,

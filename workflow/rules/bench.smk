@@ -8,11 +8,13 @@ rule bench_physics:
         "results/{scale}/logs/bench_physics.log",
     benchmark:
         "results/{scale}/benchmarks/bench_physics.tsv"
+    params:
+        overrides=ARGS,
     threads: 1
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish bench physics scale={wildcards.scale} --out results/{wildcards.scale}/bench > {log} 2>&1"
+        "efish bench physics scale={wildcards.scale} {params.overrides} --out results/{wildcards.scale}/bench > {log} 2>&1"
 
 
 rule bench_accuracy:
@@ -23,11 +25,13 @@ rule bench_accuracy:
         "results/{scale}/logs/bench_accuracy.log",
     benchmark:
         "results/{scale}/benchmarks/bench_accuracy.tsv"
+    params:
+        overrides=ARGS,
     threads: 1
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish bench accuracy scale={wildcards.scale} --out results/{wildcards.scale}/bench > {log} 2>&1"
+        "efish bench accuracy scale={wildcards.scale} {params.overrides} --out results/{wildcards.scale}/bench > {log} 2>&1"
 
 
 rule figure_bench_accuracy:

@@ -51,6 +51,28 @@ def panel_inputs(panel):
     return paths
 
 
+def selected_policy(wildcards):
+    """The final checkpoint of the seed the select_seed checkpoint chose."""
+    chosen = checkpoints.select_seed.get(scale=wildcards.scale).output.seed
+    seed = int(Path(chosen).read_text().strip())
+    return f"results/{wildcards.scale}/train/seed_{seed}/final.pt"
+
+
+def assay_policy(wildcards):
+    """The policy an assay's config asks for: the homing policy, or the selected foraging seed."""
+    if assay_config(wildcards.assay).assay.policy == "homing":
+        return f"results/{wildcards.scale}/train/homing/final.pt"
+    return selected_policy(wildcards)
+
+
+def panel_of(wildcards):
+    """The registered panel named by the wildcards; an unknown one is one clear error."""
+    key = f"{wildcards.figure}/{wildcards.panel}"
+    if key not in PANELS:
+        raise WorkflowError(f"unknown panel {key!r}: choose one of {', '.join(PANELS)}")
+    return PANELS[key]
+
+
 def all_targets():
     """Every final output of the pipeline at the chosen scale."""
     targets = [

@@ -1,13 +1,6 @@
 # Panels: one job per registered panel (efish.figures.registry), one page per figure.
 
 
-def panel_of(wildcards):
-    key = f"{wildcards.figure}/{wildcards.panel}"
-    if key not in PANELS:
-        raise WorkflowError(f"unknown panel {key!r}: choose one of {', '.join(PANELS)}")
-    return PANELS[key]
-
-
 rule panel:
     input:
         lambda w: panel_inputs(panel_of(w)),

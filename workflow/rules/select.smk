@@ -39,10 +39,3 @@ checkpoint select_seed:
         "../envs/efish.yaml"
     shell:
         "efish select scale={wildcards.scale} {params.overrides} --episodes {input} --out results/{wildcards.scale}/analysis/selection > {log} 2>&1"
-
-
-def selected_policy(wildcards):
-    """The final checkpoint of the seed the select_seed checkpoint chose."""
-    chosen = checkpoints.select_seed.get(scale=wildcards.scale).output.seed
-    seed = int(Path(chosen).read_text().strip())
-    return f"results/{wildcards.scale}/train/seed_{seed}/final.pt"
