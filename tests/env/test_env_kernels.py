@@ -10,7 +10,7 @@ import numpy as np
 
 from efish.config import compose
 from efish.env import VecEnv
-from efish.env.arenas import _wrap_2pi, drift_orientations
+from efish.env.arenas import _wrap_2pi, drift_orientations, points_in_disc
 from efish.env.dynamics import record_motion
 from efish.env.observe import TAIL_SIZES, tail_kernel
 from efish.env.rewards import FORAGING_PARTS, foraging_rewards
@@ -110,6 +110,27 @@ def test_drift_in_place_equals_the_numpy_formula():
     drift_orientations(got, sd, np.random.default_rng(5), out=got)
     assert_bits(got, want)
     assert_bits(drift_orientations(phi, sd, np.random.default_rng(5)), want)
+
+
+def numpy_points_in_disc(centre, radius, count, w, h, rng):
+    """Rejection sampling in the disc, as whole-array numpy rounds (same draws as ``points_in_disc``)."""
+    out = np.zeros((0, 2))
+    while len(out) < count:
+        r = radius * np.sqrt(rng.uniform(size=2 * count))
+        a = rng.uniform(0, 2 * np.pi, size=2 * count)
+        p = centre + np.stack([r * np.cos(a), r * np.sin(a)], axis=1)
+        inside = (p[:, 0] >= 0) & (p[:, 0] <= w) & (p[:, 1] >= 0) & (p[:, 1] <= h)
+        out = np.concatenate([out, p[inside]])
+    return out[:count]
+
+
+def test_points_in_disc_equals_the_numpy_rejection_sampler():
+    # discs well inside, across a wall and in a corner (most draws rejected, several rounds)
+    for centre, count in (((35.0, 35.0), 40), ((1.0, 30.0), 25), ((0.0, 0.0), 30), ((69.5, 70.0), 1), ((5, 5), 0)):
+        got = points_in_disc(np.array(centre), 6.0, count, 70.0, 70.0, a := np.random.default_rng(count))
+        want = numpy_points_in_disc(np.array(centre), 6.0, count, 70.0, 70.0, b := np.random.default_rng(count))
+        assert_bits(got, want)
+        assert a.random() == b.random()
 
 
 def test_reference_physics_env_matches_the_fast_env_closely():

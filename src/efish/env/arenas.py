@@ -133,15 +133,32 @@ def _wrap_2pi(x, out):
 
 def points_in_disc(centre: np.ndarray, radius: float, count: int, w: float, h: float,
                    rng: np.random.Generator) -> np.ndarray:
-    """``count`` points uniform in the part of the disc that lies inside the arena (rejection)."""
-    out = np.zeros((0, 2))
-    while len(out) < count:
-        r = radius * np.sqrt(rng.uniform(size=2 * count))
+    """``count`` points uniform in the part of the disc that lies inside the arena (rejection).
+
+    Each round draws 2 ``count`` radii and angles and keeps, in order, the points inside the arena.
+    """
+    out = np.empty((count, 2))
+    kept = 0
+    while kept < count:
+        u = rng.uniform(size=2 * count)
         a = rng.uniform(0, 2 * np.pi, size=2 * count)
-        p = centre + np.stack([r * np.cos(a), r * np.sin(a)], axis=1)
-        inside = (p[:, 0] >= 0) & (p[:, 0] <= w) & (p[:, 1] >= 0) & (p[:, 1] <= h)
-        out = np.concatenate([out, p[inside]])
-    return out[:count]
+        kept = _keep_inside(float(centre[0]), float(centre[1]), radius, u, a, w, h, out, kept)
+    return out
+
+
+@njit(cache=True)
+def _keep_inside(cx, cy, radius, u, angle, w, h, out, kept):
+    """Append to ``out[kept:]`` the points (radius sqrt(u), angle) around (cx, cy) that lie in [0, w] x [0, h];
+    returns the new count (stops when ``out`` is full)."""
+    for k in range(u.size):
+        if kept == out.shape[0]:
+            break
+        r = radius * np.sqrt(u[k])
+        x, y = cx + r * np.cos(angle[k]), cy + r * np.sin(angle[k])
+        if 0.0 <= x <= w and 0.0 <= y <= h:
+            out[kept, 0], out[kept, 1] = x, y
+            kept += 1
+    return kept
 
 
 def _concat(parts: list[np.ndarray]) -> np.ndarray:

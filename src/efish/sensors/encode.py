@@ -83,7 +83,7 @@ def noisy_kernel(morm, amp, knoll, u, emitting, size, lin, typed, flags, slots, 
     b_count, n, n_m = morm.shape
     n_a, n_k = amp.shape[2], knoll.shape[3]
     noisy, knoll_on = flags[NOISE] != 0, flags[KNOLL_ON] != 0
-    cast = np.empty(1, morm.dtype)  # rounds a float64 factor to the raw dtype, as numpy's astype does
+    as_raw = morm.dtype.type  # rounds a float64 factor to the raw dtype, as numpy's astype does
     u_amp, u_jam, u_knoll = morm.size, morm.size + amp.size, morm.size + 2 * amp.size
     k0 = n_m + n_a
     s0 = k0 + slots * n_k
@@ -96,8 +96,7 @@ def noisy_kernel(morm, amp, knoll, u, emitting, size, lin, typed, flags, slots, 
             for k in range(n_m):
                 s = morm[b, i, k]
                 if noisy:
-                    cast[0] = lin[LO] + lin[SCALE] * u[row * n_m + k]
-                    s = s * cast[0]
+                    s = s * as_raw(lin[LO] + lin[SCALE] * u[row * n_m + k])
                 mag[b, i, k] = min(max(abs(np.float64(s)), lin[M_EMIN]), lin[M_EMAX])
                 sgn[b, i, k] = np.sign(np.float64(s))
             jammed = emitters - emitting[b, i] > 0  # a conspecific emits: EOD interference
@@ -105,10 +104,9 @@ def noisy_kernel(morm, amp, knoll, u, emitting, size, lin, typed, flags, slots, 
                 s = amp[b, i, k]
                 if noisy:
                     if jammed:
-                        cast[0] = lin[JAM_LO] + lin[JAM_SCALE] * u[u_jam + row * n_a + k]
+                        s = s * as_raw(lin[JAM_LO] + lin[JAM_SCALE] * u[u_jam + row * n_a + k])
                     else:
-                        cast[0] = lin[LO] + lin[SCALE] * u[u_amp + row * n_a + k]
-                    s = s * cast[0]
+                        s = s * as_raw(lin[LO] + lin[SCALE] * u[u_amp + row * n_a + k])
                 mag[b, i, n_m + k] = min(max(abs(np.float64(s)), lin[A_EMIN]), lin[A_EMAX])
                 sgn[b, i, n_m + k] = np.sign(np.float64(s))
             for j in range(slots):
@@ -118,15 +116,13 @@ def noisy_kernel(morm, amp, knoll, u, emitting, size, lin, typed, flags, slots, 
                     if j < n - 1 and knoll_on:
                         s = knoll[b, i, j, k]
                         if noisy:
-                            cast[0] = lin[LO] + lin[SCALE] * u[u_knoll + (row * (n - 1) + j) * n_k + k]
-                            s = s * cast[0]
+                            s = s * as_raw(lin[LO] + lin[SCALE] * u[u_knoll + (row * (n - 1) + j) * n_k + k])
                         if abs(s) > typed[THRESHOLD]:
                             spike = np.sign(s)
                     heard = heard or spike != 0.0
                     out[b, i, k0 + j * n_k + k] = spike
                 if heard:
-                    cast[0] = size[b, j if j < i else j + 1]
-                    out[b, i, s0 + j] = typed[HALF] + typed[HALF] * cast[0]
+                    out[b, i, s0 + j] = typed[HALF] + typed[HALF] * as_raw(size[b, j if j < i else j + 1])
                 else:
                     out[b, i, s0 + j] = 0.0
 
@@ -138,14 +134,13 @@ def log_kernel(log_mag, sgn, n_m, lin, flags, out):
     y = sign(s) * (log10 m - log10 E_min) / (log10 E_max - log10 E_min), the
     operations and order of ``log_normalize``; disabled classes read 0.
     """
-    for b in range(out.shape[0]):
-        for i in range(out.shape[1]):
-            for k in range(log_mag.shape[2]):
-                if k < n_m:
-                    on, l_min, span = flags[MORM_ON], lin[M_LMIN], lin[M_SPAN]
-                else:
-                    on, l_min, span = flags[AMP_ON], lin[A_LMIN], lin[A_SPAN]
-                out[b, i, k] = sgn[b, i, k] * (log_mag[b, i, k] - l_min) / span if on else 0.0
+    blocks = ((0, n_m, flags[MORM_ON], lin[M_LMIN], lin[M_SPAN]),
+              (n_m, log_mag.shape[2], flags[AMP_ON], lin[A_LMIN], lin[A_SPAN]))
+    for start, stop, on, l_min, span in blocks:
+        for b in range(out.shape[0]):
+            for i in range(out.shape[1]):
+                for k in range(start, stop):
+                    out[b, i, k] = sgn[b, i, k] * (log_mag[b, i, k] - l_min) / span if on else 0.0
 
 
 def encode_readings(raw: RawReadings, u: np.ndarray | None, emitting: np.ndarray, size: np.ndarray,
