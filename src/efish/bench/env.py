@@ -8,7 +8,6 @@ import numpy as np
 
 from ..config.schema import EfishConfig
 from ..env.vec_env import VecEnv
-from ..sensing import sense_batch
 from .timing import best_time
 
 SCENES = {"patchy70": "4-agent patchy 70x70", "onepatch": "2-agent one-patch 150x150"}
@@ -21,9 +20,7 @@ def _random_actions(rng: np.random.Generator, b: int, n: int) -> np.ndarray:
 def time_env(cfg: EfishConfig, num_envs: int, steps: int, seed: int, reference: bool = False,
              repeats: int = 3) -> float:
     """Agent-steps per second of ``steps`` random-action steps of ``num_envs`` arenas (one thread)."""
-    env = VecEnv(cfg, num_envs=num_envs, seed=seed)
-    if reference:  # same env, sensing through the brute-force oracle
-        env._observe = lambda eod, env=env: _reference_observe(env, eod)
+    env = VecEnv(cfg, num_envs=num_envs, seed=seed, reference=reference)  # reference: same env, oracle physics
     env.reset()
     rng = np.random.default_rng(seed)
     acts = [_random_actions(rng, num_envs, env.n) for _ in range(steps)]
@@ -33,16 +30,6 @@ def time_env(cfg: EfishConfig, num_envs: int, steps: int, seed: int, reference: 
             env.step(a)
     seconds = best_time(run, repeats=1 if reference else repeats)
     return num_envs * env.n * steps / seconds
-
-
-def _reference_observe(env: VecEnv, eod: np.ndarray) -> np.ndarray:
-    from ..env.observe import electric_block, tail_block
-
-    e = env.cfg.env
-    readings = sense_batch(env.snapshot(eod), env.plan, rng=env.noise_rng, reference=True)
-    tail = tail_block(env.last_action, env.was_bitten, env.size, env.bite_cd, env.eat_cd, env.displacement,
-                      env.v_max(), e.eat_cooldown, e.bite_cooldown)
-    return np.concatenate([electric_block(readings, e.obs_agents), tail], axis=-1)
 
 
 def bench_env(cfg: EfishConfig, num_envs: int = 16, steps: int = 100, reference_steps: int = 3) -> list[dict]:

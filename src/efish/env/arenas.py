@@ -9,6 +9,7 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
+from numba import njit
 
 from ..config.schema import ArenaConfig
 
@@ -87,26 +88,77 @@ def regrow_onepatch(cfg: ArenaConfig, n_alive: int, rng: np.random.Generator) ->
     if cfg.layout != "onepatch":
         return np.zeros((0, 2))
     count = min(rng.poisson(cfg.onepatch_regrow_mean), max(0, cfg.onepatch_cap - n_alive))
+    if count == 0:  # the common case once the patch is full: nothing more to draw
+        return np.zeros((0, 2))
     centre = np.array([cfg.width_cm, cfg.height_cm]) / 2
     return points_in_disc(centre, cfg.onepatch_radius_cm, count, cfg.width_cm, cfg.height_cm, rng)
 
 
-def drift_orientations(phi: np.ndarray, sd: float | np.ndarray, rng: np.random.Generator) -> np.ndarray:
-    """Pellet orientations after one step of drift N(0, sd) (``sd`` broadcasts), wrapped to [0, 2 pi)."""
-    return np.mod(phi + np.asarray(sd) * rng.standard_normal(np.shape(phi)), 2 * np.pi)
+def drift_orientations(phi: np.ndarray, sd: float | np.ndarray, rng: np.random.Generator,
+                       out: np.ndarray | None = None) -> np.ndarray:
+    """Pellet orientations after one step of drift N(0, sd) (``sd`` broadcasts), wrapped to [0, 2 pi).
+
+    ``out`` (may be ``phi`` itself) receives the result without temporaries.
+    Equals ``np.mod(phi + sd * z, 2 pi)`` with ``z = rng.standard_normal(phi.shape)``, bit for bit.
+    """
+    z = rng.standard_normal(np.shape(phi))
+    z *= sd
+    z += phi
+    out = np.empty(np.shape(phi)) if out is None else out
+    _wrap_2pi(z.reshape(-1), out.reshape(-1))
+    return out
+
+
+@njit(cache=True)
+def _wrap_2pi(x, out):
+    """``out = np.mod(x, 2 pi)`` bit for bit, without numpy's fmod for the usual |x| < 4 pi.
+
+    fmod is exact, so for x in [2 pi, 4 pi) it equals x - 2 pi (exact by Sterbenz),
+    for x in (-2 pi, 0) numpy adds 2 pi to x, and a zero result is +0.0.
+    """
+    period = 2 * np.pi
+    for k in range(x.size):
+        v = x[k]
+        if v == 0.0:
+            out[k] = 0.0
+        elif 0.0 < v < period:
+            out[k] = v
+        elif period <= v < 2 * period:
+            out[k] = v - period
+        elif -period < v < 0.0:
+            out[k] = v + period
+        else:
+            out[k] = v % period  # numba's float % follows the same fmod-and-adjust rule as np.mod
 
 
 def points_in_disc(centre: np.ndarray, radius: float, count: int, w: float, h: float,
                    rng: np.random.Generator) -> np.ndarray:
-    """``count`` points uniform in the part of the disc that lies inside the arena (rejection)."""
-    out = np.zeros((0, 2))
-    while len(out) < count:
-        r = radius * np.sqrt(rng.uniform(size=2 * count))
+    """``count`` points uniform in the part of the disc that lies inside the arena (rejection).
+
+    Each round draws 2 ``count`` radii and angles and keeps, in order, the points inside the arena.
+    """
+    out = np.empty((count, 2))
+    kept = 0
+    while kept < count:
+        u = rng.uniform(size=2 * count)
         a = rng.uniform(0, 2 * np.pi, size=2 * count)
-        p = centre + np.stack([r * np.cos(a), r * np.sin(a)], axis=1)
-        inside = (p[:, 0] >= 0) & (p[:, 0] <= w) & (p[:, 1] >= 0) & (p[:, 1] <= h)
-        out = np.concatenate([out, p[inside]])
-    return out[:count]
+        kept = _keep_inside(float(centre[0]), float(centre[1]), radius, u, a, w, h, out, kept)
+    return out
+
+
+@njit(cache=True)
+def _keep_inside(cx, cy, radius, u, angle, w, h, out, kept):
+    """Append to ``out[kept:]`` the points (radius sqrt(u), angle) around (cx, cy) that lie in [0, w] x [0, h];
+    returns the new count (stops when ``out`` is full)."""
+    for k in range(u.size):
+        if kept == out.shape[0]:
+            break
+        r = radius * np.sqrt(u[k])
+        x, y = cx + r * np.cos(angle[k]), cy + r * np.sin(angle[k])
+        if 0.0 <= x <= w and 0.0 <= y <= h:
+            out[kept, 0], out[kept, 1] = x, y
+            kept += 1
+    return kept
 
 
 def _concat(parts: list[np.ndarray]) -> np.ndarray:

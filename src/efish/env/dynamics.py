@@ -118,3 +118,20 @@ def nearest_pellet_distance(xy, pellet_xy, alive, out):
                     d2 = (pellet_xy[b, k, 0] - xy[b, i, 0]) ** 2 + (pellet_xy[b, k, 1] - xy[b, i, 1]) ** 2
                     best = min(best, d2)
             out[b, i] = np.sqrt(best) if best < np.inf else np.nan
+
+
+@njit(cache=True)
+def record_motion(xy, old_xy, heading, move, turn, eod, bite, displacement, last_action):
+    """What the next observation reports about this step, written in place.
+
+    ``displacement`` float64[B, N, 2]: the move in the frame of the new heading
+    (forward, left), cm; ``last_action`` float64[B, N, 4]: move, turn, eod, bite.
+    """
+    for b in range(xy.shape[0]):
+        for i in range(xy.shape[1]):
+            c, s = np.cos(heading[b, i]), np.sin(heading[b, i])
+            dx, dy = xy[b, i, 0] - old_xy[b, i, 0], xy[b, i, 1] - old_xy[b, i, 1]
+            displacement[b, i, 0] = c * dx + s * dy
+            displacement[b, i, 1] = -s * dx + c * dy
+            last_action[b, i, 0], last_action[b, i, 1] = move[b, i], turn[b, i]
+            last_action[b, i, 2], last_action[b, i, 3] = eod[b, i], bite[b, i]

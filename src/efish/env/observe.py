@@ -11,6 +11,7 @@ eat cooldown / eat_cooldown 1 | reserved 1. Unused Knollenorgan slots are 0.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 TAIL_NAMES = ("last_action", "was_bitten", "own_size", "bite_cooldown", "displacement", "eat_cooldown", "reserved")
 TAIL_SIZES = (4, 1, 1, 1, 2, 1, 1)
@@ -33,24 +34,26 @@ def ray_observation_slices(n_rays: int) -> dict[str, slice]:
     return _slices(("ray_proximity", "ray_kind") + TAIL_NAMES, (n_rays, n_rays) + TAIL_SIZES)
 
 
-def electric_block(readings: dict[str, np.ndarray], obs_agents: int) -> np.ndarray:
-    """float32[B, N, 36 + 24 + 13 (A-1)]: receptor readings, Knollenorgan slots padded to A-1."""
-    b, n, _ = readings["mormyromast"].shape
-    sk = readings["knollenorgan"].shape[3]
-    knoll = np.zeros((b, n, obs_agents - 1, sk), dtype=np.float32)
-    knoll[:, :, : n - 1] = readings["knollenorgan"]
-    size = np.zeros((b, n, obs_agents - 1), dtype=np.float32)
-    size[:, :, : n - 1] = readings["knollen_size"]
-    return np.concatenate([readings["mormyromast"], readings["ampullary"], knoll.reshape(b, n, -1), size],
-                          axis=-1).astype(np.float32)
+@njit(cache=True)
+def tail_kernel(last_action, was_bitten, size, bite_cd, eat_cd, displacement_body, v_max, eat_cooldown,
+                bite_cooldown, out, start):
+    """Write the tail of every agent into ``out[:, :, start:start + 11]`` (float32[B, N, D]).
 
-
-def tail_block(last_action: np.ndarray, was_bitten: np.ndarray, size: np.ndarray, bite_cd: np.ndarray,
-               eat_cd: np.ndarray, displacement_body: np.ndarray, v_max: np.ndarray, eat_cooldown: int,
-               bite_cooldown: int) -> np.ndarray:
-    """float32[B, N, 11]: proprioception and internal state."""
-    disp = np.clip(displacement_body / np.maximum(v_max, 1e-12)[..., None], -1, 1)
-    return np.concatenate([
-        last_action, was_bitten[..., None], size[..., None], (bite_cd / max(bite_cooldown, 1))[..., None],
-        disp, (eat_cd / max(eat_cooldown, 1))[..., None], np.zeros(was_bitten.shape + (1,)),
-    ], axis=-1).astype(np.float32)
+    Values are computed in float64 and rounded once to float32, like the
+    numpy composition they replace; the displacement is divided by
+    max(v_max, 1e-12) so a frozen agent reads 0, not NaN.
+    """
+    bite_div, eat_div = float(max(bite_cooldown, 1)), float(max(eat_cooldown, 1))
+    for b in range(out.shape[0]):
+        for i in range(out.shape[1]):
+            o = out[b, i]
+            for k in range(4):
+                o[start + k] = last_action[b, i, k]
+            o[start + 4] = was_bitten[b, i]
+            o[start + 5] = size[b, i]
+            o[start + 6] = bite_cd[b, i] / bite_div
+            v = max(v_max[b, i], 1e-12)
+            for k in range(2):
+                o[start + 7 + k] = min(max(displacement_body[b, i, k] / v, -1.0), 1.0)
+            o[start + 9] = eat_cd[b, i] / eat_div
+            o[start + 10] = 0.0

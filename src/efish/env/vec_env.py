@@ -21,17 +21,21 @@ import numpy as np
 from ..config.schema import EfishConfig
 from ..physics.plan import build_plan
 from ..physics.snapshot import SnapshotBatch
-from ..sensing import sense_batch
-from . import dynamics as dyn
+from ..sensing import raw_readings
+from ..sensors.encode import electric_width, encode_readings
 from ..sensors.layout import mormyromast_angles
+from ..sensors.noise import noise_uniforms
+from . import dynamics as dyn
 from .arenas import drift_orientations, regrow_onepatch, sample_arena, sample_pellets, spawn_agents
 from .bot import bot_actions
-from .observe import electric_block, tail_block
+from .observe import TAIL_SIZES, tail_kernel
 from .raycast import cast_rays
-from .rewards import foraging_rewards, homing_rewards
+from .rewards import foraging_coefficients, foraging_rewards, homing_rewards
 
-
-_DERIVED = ("cfg", "plan", "params", "muted", "frozen", "bots", "homing", "target", "ray_angles", "autoreset")
+# Not part of state_dict: fixed by the config, or caches rebuilt from the state (see _refresh_caches).
+_DERIVED = ("cfg", "plan", "params", "muted", "frozen", "bots", "homing", "target", "ray_angles", "autoreset",
+            "reference", "reward_coef", "perception_width", "_v_max", "_w_max", "_drift_sd", "_regrowing",
+            "_noise_u")
 
 
 def _sigmoid(x: np.ndarray) -> np.ndarray:
@@ -47,13 +51,15 @@ class VecEnv:
     ``obs, reward[B, N], terminated[B], truncated[B], info``. Arenas that end
     are reset in the same call; their last observation is in ``info["final_obs"]``
     (with ``autoreset=False`` they are left as they ended, for recording).
+    ``reference=True`` senses through the brute-force physics oracle
+    (benchmarks and tests only, never training).
     """
 
-    def __init__(self, cfg: EfishConfig, num_envs: int, seed: int, autoreset: bool = True):
+    def __init__(self, cfg: EfishConfig, num_envs: int, seed: int, autoreset: bool = True, reference: bool = False):
         if num_envs < 1:
             raise ValueError(f"num_envs must be >= 1, got {num_envs}")
         self.cfg, self.num_envs, self.n = cfg, int(num_envs), cfg.env.n_agents
-        self.autoreset = autoreset
+        self.autoreset, self.reference = autoreset, reference
         root = np.random.SeedSequence(seed)
         children = root.spawn(num_envs + 1)
         self.rngs = [np.random.default_rng(s) for s in children[:-1]]
@@ -72,7 +78,12 @@ class VecEnv:
         self.homing = e.task == "homing"
         self.target = np.arange(self.n) == e.homing_target if self.homing else np.zeros(self.n, bool)
         self.ray_angles = mormyromast_angles(cfg.sensors.mormyromast)[: cfg.sensors.ray_count]
+        self.reward_coef = foraging_coefficients(e)
+        self.perception_width = 2 * len(self.ray_angles) if cfg.sensors.perception == "raycast" else electric_width(
+            len(self.plan.morm_angles), len(self.plan.amp_angles), len(self.plan.knollen_angles), e.obs_agents - 1)
+        self._noise_u = None  # scratch for the noise draws, reused every step
         self._allocate(pellet_capacity=1)
+        self._refresh_caches()
 
     # ------------------------------------------------------------------ state
     def _allocate(self, pellet_capacity: int) -> None:
@@ -141,6 +152,7 @@ class VecEnv:
         """Start a new episode in every arena; observations float32[B, N, D]."""
         for b in range(self.num_envs):
             self._reset_env(b)
+        self._refresh_caches()
         self._distances(self.d_food)
         return self._observe(np.zeros((self.num_envs, self.n), bool) | self.target)
 
@@ -173,31 +185,28 @@ class VecEnv:
             self._drive_bots(move, turn, eod)
         eod = (eod & ~self.muted) | self.target
         old_xy = self.xy.copy()
-        ate, collided, can_bite = (np.zeros((self.num_envs, self.n), bool) for _ in range(3))
+        shape = (self.num_envs, self.n)
+        ate, collided, can_bite = np.empty(shape, bool), np.empty(shape, bool), np.empty(shape, bool)  # kernel-filled
         no_eating = bite | self.bots[None, :]  # bots never eat: they enter the kernel as if biting
-        dyn.eat_and_move(self.xy, self.heading, self.eat_cd, self.bite_cd, move, turn, no_eating, self.v_max(),
-                         self.w_max(), self.pellet_xy, self.alive, self.width, self.height, self.params,
+        dyn.eat_and_move(self.xy, self.heading, self.eat_cd, self.bite_cd, move, turn, no_eating, self._v_max,
+                         self._w_max, self.pellet_xy, self.alive, self.width, self.height, self.params,
                          ate, collided, can_bite)
         # 4. bites, simultaneously, on post-move positions (3. sensing happens in _observe)
-        bit, bitten_by = np.zeros_like(ate), np.zeros((self.num_envs, self.n), np.int64)
-        penalty = np.zeros((self.num_envs, self.n))
+        bit, bitten_by, penalty = np.empty(shape, bool), np.empty(shape, np.int64), np.empty(shape)  # kernel-filled
         dyn.resolve_bites(self.xy, self.heading, self.size, bite, can_bite, self.bite_cd, self.params,
                           bitten_by, bit, penalty)
         # 5. rewards
         d_prev = self.d_food.copy()
         self._distances(self.d_food)
-        perimeter = 2 * (self.width + self.height)
         if self.homing:
-            rewards = homing_rewards(e, d_prev, self.d_food, perimeter, self.target)
+            rewards = homing_rewards(e, d_prev, self.d_food, 2 * (self.width + self.height), self.target)
             at_home = (self.d_food <= e.homing_radius_cm) & ~self.target
             self.home_steps = np.where(at_home, self.home_steps + 1, 0)
         else:
-            rewards = foraging_rewards(e, ate, d_prev, self.d_food, perimeter, penalty, bit, collided, move, turn)
+            rewards = foraging_rewards(e, ate, d_prev, self.d_food, self.width, self.height, penalty, bit, collided,
+                                       move, turn, self.reward_coef)
         # 6. observations
-        delta = self.xy - old_xy
-        c, s = np.cos(self.heading), np.sin(self.heading)
-        self.displacement = np.stack([c * delta[..., 0] + s * delta[..., 1], -s * delta[..., 0] + c * delta[..., 1]], -1)
-        self.last_action = np.stack([move, turn, eod, bite], axis=-1).astype(np.float64)
+        dyn.record_motion(self.xy, old_xy, self.heading, move, turn, eod, bite, self.displacement, self.last_action)
         self.was_bitten = bitten_by > 0
         info = {"ate": ate, "bit": bit, "was_bitten": self.was_bitten.copy(), "bitten_by": bitten_by,
                 "collided": collided, "eod": eod, "move": move, "turn": turn, "bite": bite,
@@ -213,6 +222,7 @@ class VecEnv:
             info["final_obs"] = obs.copy()
             for b in np.flatnonzero(done):
                 self._reset_env(b)
+            self._refresh_caches()
             self._distances(self.d_food)
             obs[done] = self._observe(np.zeros((self.num_envs, self.n), bool) | self.target)[done]
         return obs, rewards["total"], terminated, truncated, info
@@ -224,24 +234,27 @@ class VecEnv:
     def load_state_dict(self, state: dict) -> None:
         """Restore what :meth:`state_dict` returned."""
         self.__dict__.update(copy.deepcopy(state))
+        self._refresh_caches()
+
+    def _refresh_caches(self) -> None:
+        """Rebuild what only changes at resets: speed limits (sizes) and the food dynamics of each arena."""
+        self._v_max, self._w_max = self.v_max(), self.w_max()
+        self._drift_sd = np.array([a.orientation_drift_rad for a in self.arena])[:, None]
+        self._regrowing = [b for b, a in enumerate(self.arena) if a.layout == "onepatch"]
 
     # --------------------------------------------------------------- helpers
     def _food_dynamics(self) -> None:
         """Orientation drift of every pellet (one draw for the batch), then one-patch regrowth."""
-        sd = np.array([a.orientation_drift_rad for a in self.arena])[:, None]
-        self.pellet_phi = drift_orientations(self.pellet_phi, sd, self.noise_rng)
+        drift_orientations(self.pellet_phi, self._drift_sd, self.noise_rng, out=self.pellet_phi)
+        n_alive = self.alive.sum(axis=1) if self._regrowing else None  # one count for the batch, not one per arena
         for b in self._regrowing:
             arena, rng = self.arena[b], self.rngs[b]
-            new = regrow_onepatch(arena, int(self.alive[b].sum()), rng)
+            new = regrow_onepatch(arena, int(n_alive[b]), rng)
             if len(new):
                 free = np.flatnonzero(~self.alive[b])[: len(new)]
                 self.pellet_xy[b, free] = new[: len(free)]
                 self.pellet_phi[b, free] = rng.uniform(0, 2 * np.pi, len(free))
                 self.alive[b, free] = True
-
-    @property
-    def _regrowing(self) -> list[int]:
-        return [b for b, a in enumerate(self.arena) if a.layout == "onepatch"]
 
     def snapshot(self, eod: np.ndarray) -> SnapshotBatch:
         """The current state as the sensing input."""
@@ -257,28 +270,34 @@ class VecEnv:
             dyn.nearest_pellet_distance(self.xy, self.pellet_xy, self.alive, out)
 
     def _drive_bots(self, move: np.ndarray, turn: np.ndarray, eod: np.ndarray) -> None:
-        e, ids = self.cfg.env, np.flatnonzero(self.bots)
-        w_max = self.w_max()
+        e, ids, w_max = self.cfg.env, np.flatnonzero(self.bots), self._w_max
         for b in range(self.num_envs):
             centre = np.array([self.width[b], self.height[b]]) / 2
             m, t, f = bot_actions(self.xy[b, ids], self.heading[b, ids], w_max[b, ids], centre, e.bot_radius_cm,
                                   e.bot_eod_rate, self.rngs[b])
             move[b, ids], turn[b, ids], eod[b, ids] = m, t, f
 
-    def perception(self, eod: np.ndarray) -> np.ndarray:
-        """The sensory part of the observation: electric receptors or rays."""
+    def _perceive(self, eod: np.ndarray, out: np.ndarray) -> None:
+        """Write the sensory part of the observation into ``out[..., :perception_width]``: receptors or rays."""
         if self.cfg.sensors.perception == "raycast":
             shape = (self.num_envs, self.n, len(self.ray_angles))
             prox, kind = np.zeros(shape), np.zeros(shape)
             cast_rays(self.xy, self.heading, self.pellet_xy, self.alive, self.width, self.height, self.ray_angles,
                       self.cfg.sensors.ray_length_cm, self.cfg.env.body_radius_cm, self.cfg.physics.pellet_radius_cm,
                       prox, kind)
-            return np.concatenate([prox, kind], axis=-1).astype(np.float32)
-        readings = sense_batch(self.snapshot(eod), self.plan, rng=self.noise_rng)
-        return electric_block(readings, self.cfg.env.obs_agents)
+            out[..., : shape[2]], out[..., shape[2]: 2 * shape[2]] = prox, kind
+            return
+        raw = raw_readings(self.snapshot(eod), self.plan, reference=self.reference)
+        if self.plan.noise:
+            self._noise_u = noise_uniforms(raw, self.noise_rng, out=self._noise_u)
+        encode_readings(raw, self._noise_u if self.plan.noise else None, eod & self.plan.on("eod_emission"),
+                        self.size, self.plan, self.cfg.env.obs_agents - 1, out)
 
     def _observe(self, eod: np.ndarray) -> np.ndarray:
-        e = self.cfg.env
-        tail = tail_block(self.last_action, self.was_bitten, self.size, self.bite_cd, self.eat_cd, self.displacement,
-                          self.v_max(), e.eat_cooldown, e.bite_cooldown)
-        return np.concatenate([self.perception(eod), tail], axis=-1)
+        """Observations float32[B, N, D] (SPEC 4): perception, then the tail, written into one fresh array."""
+        e, p = self.cfg.env, self.perception_width
+        obs = np.empty((self.num_envs, self.n, p + sum(TAIL_SIZES)), np.float32)
+        self._perceive(eod, obs)
+        tail_kernel(self.last_action, self.was_bitten, self.size, self.bite_cd, self.eat_cd, self.displacement,
+                    self._v_max, e.eat_cooldown, e.bite_cooldown, obs, p)
+        return obs

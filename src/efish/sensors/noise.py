@@ -8,19 +8,40 @@ from ..physics.plan import EffectPlan
 from ..physics.reference import RawReadings
 
 
+def noise_uniforms(raw: RawReadings, rng: np.random.Generator, out: np.ndarray | None = None) -> np.ndarray:
+    """U(0, 1) draws of one step of noise, float64, flat: Mormyromast | Ampullary | interference | Knollenorgan.
+
+    One ``rng.random`` call for the whole batch (each block in C order). The
+    noise factor is ``low + (high - low) * u``, which is what
+    ``Generator.uniform(low, high)`` computes from the same draws, so this fixes
+    the draw order for every consumer (``apply_noise`` and the fused encoder).
+    """
+    count = raw.mormyromast.size + 2 * raw.ampullary.size + raw.knollenorgan.size
+    if out is None or out.size != count:
+        out = np.empty(count)
+    return rng.random(out=out)
+
+
 def apply_noise(raw: RawReadings, emitting: np.ndarray, plan: EffectPlan, rng: np.random.Generator) -> RawReadings:
     """Multiply every raw reading by U(low, high); Ampullary readings by the interference
     range instead on steps where any conspecific of the reading agent emits.
 
-    ``emitting``: bool[B, N]. Draw order is fixed (Mormyromast, Ampullary,
-    interference, Knollenorgan), so one generator state gives the same noise.
+    ``emitting``: bool[B, N]. Draws come from :func:`noise_uniforms`, so one
+    generator state gives the same noise here and in the fused encoder.
     """
-    lo, hi = plan.noise_range
+    (lo, hi), (jlo, jhi) = plan.noise_range, plan.interference_range
     dtype = raw.mormyromast.dtype
-    m = raw.mormyromast * rng.uniform(lo, hi, raw.mormyromast.shape).astype(dtype)
-    plain = rng.uniform(lo, hi, raw.ampullary.shape)
-    jam = rng.uniform(*plan.interference_range, raw.ampullary.shape)
+    u = noise_uniforms(raw, rng)
+    ends = np.cumsum([raw.mormyromast.size, raw.ampullary.size, raw.ampullary.size])
+    u_m, u_a, u_jam, u_k = np.split(u, ends)
+
+    def factor(draws, low, high, shape):
+        return (low + (high - low) * draws).reshape(shape).astype(dtype)
+
+    m = raw.mormyromast * factor(u_m, lo, hi, raw.mormyromast.shape)
+    plain = factor(u_a, lo, hi, raw.ampullary.shape)
+    jam = factor(u_jam, jlo, jhi, raw.ampullary.shape)
     others_emit = (emitting.sum(axis=1, keepdims=True) - emitting) > 0      # [B, N]
-    a = raw.ampullary * np.where(others_emit[..., None], jam, plain).astype(dtype)
-    k = raw.knollenorgan * rng.uniform(lo, hi, raw.knollenorgan.shape).astype(dtype)
+    a = raw.ampullary * np.where(others_emit[..., None], jam, plain)
+    k = raw.knollenorgan * factor(u_k, lo, hi, raw.knollenorgan.shape)
     return RawReadings(mormyromast=m, ampullary=a, knollenorgan=k)
