@@ -10,6 +10,7 @@
     efish bench accuracy [overrides] --out D  accuracy-vs-time study -> table + figure
     efish bench env [overrides] [--json]      env-only throughput, fast vs reference physics
     efish bench train [overrides] [--json]    rollout/update speed, model-FLOP utilisation
+    efish bench pipeline [--results D]        time per rule family of a pipeline run (Snakemake benchmarks)
 
 Overrides are Hydra's ``key=value`` (``physics.image_order=2``) or group
 choices (``arena=patchy70``). Every error is one line on stderr, exit code 2,
@@ -69,6 +70,10 @@ def _parser() -> argparse.ArgumentParser:
     bt.add_argument("overrides", nargs="*")
     bt.add_argument("--json", action="store_true", help="print JSON instead of a table")
     bt.add_argument("--hidden", type=int, nargs="+", default=[512, 64], help="widths to time (default 512 64)")
+    bpl = bsub.add_parser("pipeline", help="time per rule family of a finished pipeline run")
+    bpl.add_argument("overrides", nargs="*")
+    bpl.add_argument("--results", type=Path, help="results folder of the run (default results/{scale})")
+    bpl.add_argument("--json", action="store_true", help="print JSON records instead of a table")
     ba = bsub.add_parser("accuracy", help="accuracy-vs-time sweep: table and figure")
     ba.add_argument("overrides", nargs="*")
     ba.add_argument("--out", type=Path, default=Path("results/bench"), help="output folder (default results/bench)")
@@ -246,6 +251,11 @@ def main(argv: Sequence[str] | None = None) -> int:
 
             rows = bench_env(cfg, num_envs=args.envs, steps=args.steps)
             print(json.dumps(rows, indent=2) if args.json else format_env(rows))
+        elif args.bench == "pipeline":
+            from .bench.pipeline import format_timings, pipeline_timings
+
+            table = pipeline_timings(args.results or Path(f"results/{cfg.scale.name}"))
+            print(table.to_json(orient="records", indent=1) if args.json else format_timings(table))
         else:
             _bench_accuracy(args, cfg, started)
     except (ConfigError, ValueError, OSError) as exc:
