@@ -103,3 +103,39 @@ def test_episode_start_forgets_the_hidden_state():
 def test_heads_start_small():
     actor = Actor(110, 64)
     assert actor.head.weight.abs().max() < 0.05 and torch.all(actor.log_std == 0)
+
+
+def test_micro_batches_give_the_same_update_as_one_pass():
+    """Gradient accumulation over micro-batches is a compute choice: the weights after an update match
+    those of one pass over the whole minibatch (to float32 summation order)."""
+    import copy
+    import dataclasses
+
+    from efish.config import compose
+    from efish.rl.mappo import Rollout, ppo_update
+
+    T, S, D, N, H = 8, 12, 6, 2, 16
+    g = torch.Generator().manual_seed(0)
+    ro = Rollout(obs=torch.randn(T, S, D, generator=g), state=torch.randn(T, S, D * N, generator=g),
+                 actions=torch.rand(T, S, 4, generator=g).round(), logp=-torch.rand(T, S, generator=g),
+                 values=torch.randn(T, S, generator=g), advantages=torch.randn(T, S, generator=g),
+                 returns=torch.randn(T, S, generator=g), starts=(torch.rand(T, S, generator=g) < 0.1).float(),
+                 h_actor=torch.zeros(2, S, H), h_critic=torch.zeros(2, S, H))
+    base = compose(["train.chunk=4", "train.rollout_steps=8", "train.epochs=2", "train.minibatches=2"]).train
+    torch.manual_seed(1)
+    actor0, critic0 = Actor(D, H), Critic(D * N, H)
+    results = []
+    for micro in (1000, 5):  # one pass per minibatch of 12 sequences, or passes of 5 + 5 + 2
+        cfg = dataclasses.replace(base, micro_sequences=micro, hidden=H)
+        actor, critic = copy.deepcopy(actor0), copy.deepcopy(critic0)
+        opt_a, opt_c = torch.optim.Adam(actor.parameters(), lr=1e-3), torch.optim.Adam(critic.parameters(), lr=1e-3)
+        stats = ppo_update(cfg, actor, critic, opt_a, opt_c, ValueNormalizer(), ro, torch.Generator().manual_seed(2))
+        results.append((actor.state_dict(), critic.state_dict(), stats))
+    (a1, c1, s1), (a2, c2, s2) = results
+    for key in a1:
+        torch.testing.assert_close(a1[key], a2[key], rtol=1e-4, atol=1e-5)
+    for key in c1:
+        torch.testing.assert_close(c1[key], c2[key], rtol=1e-4, atol=1e-5)
+    for key in s1:
+        assert s1[key] == pytest.approx(s2[key], rel=1e-4, abs=1e-6), key
+    assert any(not torch.equal(a1[k], v) for k, v in actor0.state_dict().items())  # the update moved the weights

@@ -36,9 +36,19 @@ def forward_flops(input_dim: int, hidden: int, out_dim: int) -> int:
     return mlp + gru + 2 * hidden * out_dim
 
 
+def timed_sequences(cfg: EfishConfig) -> int:
+    """Sequences in one forward/backward pass of the configured update: a minibatch of chunks
+    (arenas x agents x rollout/chunk / minibatches), cut to ``train.micro_sequences``. Timing one such
+    pass of ``train.chunk`` steps gives the update's throughput without timing a whole paper-size epoch."""
+    t = cfg.train
+    per_minibatch = max(1, t.num_envs * cfg.env.n_agents * (t.rollout_steps // t.chunk) // t.minibatches)
+    return min(per_minibatch, t.micro_sequences)
+
+
 def update_rate(cfg: EfishConfig, obs_dim: int, n_agents: int, sequences: int, steps: int) -> tuple[float, float]:
-    """(samples/s, model FLOP/s) of one PPO epoch on a synthetic rollout."""
-    t = dataclasses.replace(cfg.train, epochs=1, minibatches=1, rollout_steps=steps)
+    """(samples/s, model FLOP/s) of one PPO epoch over ``sequences`` sequences of ``steps`` steps (one chunk
+    each), on a synthetic rollout."""
+    t = dataclasses.replace(cfg.train, epochs=1, minibatches=1, rollout_steps=steps, chunk=steps)
     actor, critic = Actor(obs_dim, t.hidden), Critic(obs_dim * n_agents, t.hidden)
     opt_a, opt_c = torch.optim.Adam(actor.parameters()), torch.optim.Adam(critic.parameters())
     n_chunks = steps // t.chunk
@@ -72,9 +82,9 @@ def rollout_rate(cfg: EfishConfig, steps: int) -> float:
     return steps * t.num_envs / (time.perf_counter() - t0)
 
 
-def bench_train(cfg: EfishConfig, hiddens: tuple[int, ...], sequences: int = 16, steps: int = 100,
-                rollout_steps: int = 50) -> list[dict]:
-    """One row per (hidden width, precision)."""
+def bench_train(cfg: EfishConfig, hiddens: tuple[int, ...], rollout_steps: int = 50) -> list[dict]:
+    """One row per (hidden width, precision): the update timed at the configured pass shape
+    (:func:`timed_sequences` x ``train.chunk``), a short rollout, and the end-to-end rate they imply."""
     torch.set_num_threads(cfg.train.threads)
     obs_dim, n_agents = 110, cfg.env.n_agents
     peaks = {"fp32": gemm_flops(torch.float32)}
@@ -85,7 +95,7 @@ def bench_train(cfg: EfishConfig, hiddens: tuple[int, ...], sequences: int = 16,
     for hidden in hiddens:
         for precision, peak in peaks.items():
             c = dataclasses.replace(cfg, train=dataclasses.replace(cfg.train, hidden=hidden, bf16=precision == "bf16"))
-            samples_s, flops_s = update_rate(c, obs_dim, n_agents, sequences, steps)
+            samples_s, flops_s = update_rate(c, obs_dim, n_agents, timed_sequences(c), c.train.chunk)
             env_s = rollout_rate(c, rollout_steps)
             per_update = c.train.rollout_steps * c.train.num_envs
             update_s = per_update * n_agents * c.train.epochs / samples_s

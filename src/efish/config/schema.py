@@ -211,6 +211,9 @@ class TrainConfig:
     weight_decay: float = param(1e-6, "Adam weight decay", lo=0.0)
     epochs: int = param(15, "PPO epochs per update", lo=1)
     minibatches: int = param(1, "minibatches per epoch (split over sequences)", lo=1)
+    micro_sequences: int = param(256, "sequences per forward/backward pass; a minibatch's gradients are summed "
+                                      "over these micro-batches before its one optimiser step (same update, "
+                                      "cache-sized work)", lo=1)
     clip: float = param(0.2, "PPO ratio clip and value clip", lo=0.0, hi=1.0)
     entropy_coef: float = param(0.01, "entropy bonus", lo=0.0)
     value_coef: float = param(1.0, "value loss weight", lo=0.0)

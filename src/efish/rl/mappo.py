@@ -45,6 +45,36 @@ def chunked(x: torch.Tensor, chunk: int) -> torch.Tensor:
     return x.reshape(t // chunk, chunk, s, *x.shape[2:]).transpose(0, 1).reshape(chunk, (t // chunk) * s, *x.shape[2:])
 
 
+def micro_losses(cfg: TrainConfig, actor: Actor, critic: Critic, data: dict, h_a: torch.Tensor, h_c: torch.Tensor,
+                 idx: torch.Tensor, share: float) -> dict[str, float]:
+    """Losses of the sequences ``idx``; backpropagates ``share`` x (actor loss) and ``share`` x (critic loss)
+    into the gradients, and returns the unweighted statistics."""
+    with autocast(cfg):
+        dist, _, _ = actor(data["obs"][:, idx], h_a[idx], data["starts"][:, idx])
+    dist = dist.to(torch.float32)
+    logp = dist.log_prob(data["actions"][:, idx])
+    ratio = torch.exp(logp - data["logp"][:, idx])
+    a = data["adv"][:, idx]
+    policy_loss = -torch.min(ratio * a, ratio.clamp(1 - cfg.clip, 1 + cfg.clip) * a).mean()
+    entropy = dist.entropy().mean()
+    (share * (policy_loss - cfg.entropy_coef * entropy)).backward()
+
+    with autocast(cfg):
+        values, _ = critic(data["state"][:, idx], h_c[idx], data["starts"][:, idx])
+    values = values.float()
+    old, tgt = data["values"][:, idx], data["targets"][:, idx]
+    clipped = old + (values - old).clamp(-cfg.clip, cfg.clip)
+    value_loss = torch.max(F.huber_loss(values, tgt, delta=cfg.huber_delta, reduction="none"),
+                           F.huber_loss(clipped, tgt, delta=cfg.huber_delta, reduction="none")).mean()
+    (share * cfg.value_coef * value_loss).backward()
+
+    with torch.no_grad():
+        log_ratio = logp - data["logp"][:, idx]
+        return {"policy_loss": policy_loss.item(), "value_loss": value_loss.item(), "entropy": entropy.item(),
+                "approx_kl": float(((ratio - 1) - log_ratio).mean()),
+                "clip_fraction": float(((ratio - 1).abs() > cfg.clip).float().mean())}
+
+
 def ppo_update(cfg: TrainConfig, actor: Actor, critic: Critic, actor_opt: torch.optim.Optimizer,
                critic_opt: torch.optim.Optimizer, value_norm: ValueNormalizer, ro: Rollout,
                generator: torch.Generator) -> dict[str, float]:
@@ -61,38 +91,22 @@ def ppo_update(cfg: TrainConfig, actor: Actor, critic: Critic, actor_opt: torch.
     for _ in range(cfg.epochs):
         order = torch.randperm(n_seq, generator=generator)
         for idx in order.chunk(cfg.minibatches):
-            with autocast(cfg):
-                dist, _, _ = actor(data["obs"][:, idx], h_a[idx], data["starts"][:, idx])
-            dist = dist.to(torch.float32)
-            logp = dist.log_prob(data["actions"][:, idx])
-            ratio = torch.exp(logp - data["logp"][:, idx])
-            a = data["adv"][:, idx]
-            policy_loss = -torch.min(ratio * a, ratio.clamp(1 - cfg.clip, 1 + cfg.clip) * a).mean()
-            entropy = dist.entropy().mean()
+            # One optimiser step per minibatch, as in SPEC 9; the forward/backward passes run over
+            # micro-batches of sequences whose gradients add up to the minibatch's (each loss weighted by
+            # its share), because cache-sized passes run faster than one pass over the whole minibatch.
             actor_opt.zero_grad()
-            (policy_loss - cfg.entropy_coef * entropy).backward()
+            critic_opt.zero_grad()
+            sums = dict.fromkeys(stats, 0.0)
+            for micro in idx.split(cfg.micro_sequences):
+                share = len(micro) / len(idx)
+                for k, v in micro_losses(cfg, actor, critic, data, h_a, h_c, micro, share).items():
+                    sums[k] += share * v
             torch.nn.utils.clip_grad_norm_(actor.parameters(), cfg.max_grad_norm)
             actor_opt.step()
-
-            with autocast(cfg):
-                values, _ = critic(data["state"][:, idx], h_c[idx], data["starts"][:, idx])
-            values = values.float()
-            old, tgt = data["values"][:, idx], data["targets"][:, idx]
-            clipped = old + (values - old).clamp(-cfg.clip, cfg.clip)
-            value_loss = torch.max(F.huber_loss(values, tgt, delta=cfg.huber_delta, reduction="none"),
-                                   F.huber_loss(clipped, tgt, delta=cfg.huber_delta, reduction="none")).mean()
-            critic_opt.zero_grad()
-            (cfg.value_coef * value_loss).backward()
             torch.nn.utils.clip_grad_norm_(critic.parameters(), cfg.max_grad_norm)
             critic_opt.step()
-
-            with torch.no_grad():
-                log_ratio = logp - data["logp"][:, idx]
-                stats["approx_kl"].append(float(((ratio - 1) - log_ratio).mean()))
-                stats["clip_fraction"].append(float(((ratio - 1).abs() > cfg.clip).float().mean()))
-            stats["policy_loss"].append(policy_loss.item())
-            stats["value_loss"].append(value_loss.item())
-            stats["entropy"].append(entropy.item())
+            for k, v in sums.items():
+                stats[k].append(v)
     out = {k: sum(v) / len(v) for k, v in stats.items()}
     var = float(ro.returns.var())
     out["explained_variance"] = 1.0 - float((ro.returns - value_norm.denormalize(ro.values)).var()) / var if var > 0 else 0.0
