@@ -93,10 +93,13 @@ def induced_dipoles(axy, heading, emitting, bx, by, alpha, img, c, p_ind):
 
     E_e is the field of e's two monopoles and all their wall images. Bodies are
     the innermost, contiguous loop so the sums vectorise; silent agents' rows are zero.
+    ``p_ind`` may have room for more bodies than ``bx``: its rows are sliced here, so
+    numba sees them contiguous (a slice of the last axis taken by the caller is not).
     """
     kq, soft2, one = c[K] * c[Q], c[SOFT2], c[ONE]
+    nb = bx.shape[0]
     for e in range(axy.shape[0]):
-        px, py = p_ind[e, 0], p_ind[e, 1]
+        px, py = p_ind[e, 0, :nb], p_ind[e, 1, :nb]
         px[:] = c[ZERO]
         py[:] = c[ZERO]
         if not emitting[e]:

@@ -177,18 +177,22 @@ def mormyromast_moments(a, emitting, p_ind, c, mx, my):
     cons is summed directly, not formed as p_sum - p_ind[a]: near an emitting
     agent self >> cons, and the difference would lose cons to round-off (in
     float32 by up to ~0.3 after normalisation, times k_cons in cons-only runs).
+    ``p_ind`` may have room for more bodies than ``mx``; rows are sliced to fit.
     """
     gain = c[K_CONS] if (not emitting[a] or c[G_SELF] == 0) else c[ONE]
     w_cons = c[G_CONS] * gain * c[K]
     w_self = c[G_SELF] * c[K]
-    for j in range(mx.shape[0]):
-        mx[j] = w_self * p_ind[a, 0, j]
-        my[j] = w_self * p_ind[a, 1, j]
+    nb = mx.shape[0]
+    sx, sy = p_ind[a, 0, :nb], p_ind[a, 1, :nb]
+    for j in range(nb):
+        mx[j] = w_self * sx[j]
+        my[j] = w_self * sy[j]
     for e in range(emitting.shape[0]):
         if e != a and emitting[e]:
-            for j in range(mx.shape[0]):
-                mx[j] += w_cons * p_ind[e, 0, j]
-                my[j] += w_cons * p_ind[e, 1, j]
+            ex, ey = p_ind[e, 0, :nb], p_ind[e, 1, :nb]
+            for j in range(nb):
+                mx[j] += w_cons * ex[j]
+                my[j] += w_cons * ey[j]
     mx[a] = c[ZERO]
     my[a] = c[ZERO]
 
@@ -354,10 +358,10 @@ def sense_batch_kernel(agent_xy, heading, emitting, pellet_xy, pellet_phi, pelle
                 induction = induction or emitting[b, e]
         if induction:
             induced_dipoles(agent_xy[b], heading[b], emitting[b], body[0, :nb], body[1, :nb], body[2, :nb], img, c,
-                            p_ind[:, :, :nb])
+                            p_ind)
         for a in range(n if (flags[DO_MORM] or flags[DO_AMP]) else 0):
             if flags[DO_MORM] and induction:
-                mormyromast_moments(a, emitting[b], p_ind[:, :, :nb], c, body[3, :nb], body[4, :nb])
+                mormyromast_moments(a, emitting[b], p_ind, c, body[3, :nb], body[4, :nb])
             else:
                 body[3, :nb] = c[ZERO]
                 body[4, :nb] = c[ZERO]
