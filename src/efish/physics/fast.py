@@ -63,8 +63,8 @@ def prepared_inputs(plan: EffectPlan) -> tuple:
             tables[2 * row, :len(a)], tables[2 * row + 1, :len(a)] = np.cos(a), np.sin(a)
         _PREPARED[plan] = (
             plan.image_indices, arr(plan.image_weights), c, flags, arr(tables),
-            np.array(plan.far_levels, dtype=np.int64), *level_tables(plan), arr(plan.far_tables),
-            arr(plan.morm_interp.transpose(0, 2, 1)), arr(plan.amp_interp.transpose(0, 2, 1)),
+            np.array(plan.far_levels, dtype=np.int64), *level_tables(plan),
+            *(arr(t) if t.dtype.kind == "f" else t for t in flat_far_tables(plan)),
             arr(np.cos(plan.knollen_angles)), arr(np.sin(plan.knollen_angles)))
     return _PREPARED[plan]
 
@@ -99,3 +99,21 @@ def level_tables(plan: EffectPlan) -> tuple[np.ndarray, np.ndarray]:
     """
     q = np.array(plan.far_levels, dtype=np.float64)
     return np.log2(plan.far_safety * q), (q + 1) // 2
+
+
+def flat_far_tables(plan: EffectPlan) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The far-field levels' points and interpolation matrices stacked level after level.
+
+    Returns offsets (int64[L + 1], level l owns rows offsets[l]:offsets[l + 1]),
+    points (2, sum Q) cos and sin of the point angles, and the interpolation
+    matrices (36, sum Q) and (24, sum Q): the interpolation of every level
+    at once is one dense matrix-vector product per receptor class.
+    """
+    q = np.array(plan.far_levels, dtype=np.int64)
+    offsets = np.concatenate([[0], np.cumsum(q)]).astype(np.int64)
+    blocks = [(plan.far_tables[i, :, :n], plan.morm_interp[i, :, :n], plan.amp_interp[i, :, :n])
+              for i, n in enumerate(q)]
+    points = np.concatenate([b[0] for b in blocks], axis=1) if blocks else np.zeros((2, 0))
+    morm = np.concatenate([b[1] for b in blocks], axis=1) if blocks else np.zeros((len(plan.morm_angles), 0))
+    amp = np.concatenate([b[2] for b in blocks], axis=1) if blocks else np.zeros((len(plan.amp_angles), 0))
+    return offsets, points, morm, amp

@@ -58,14 +58,19 @@ def add_monopole(out, sx, sy, nx, ny, px, py, kq, soft2, one):
 
 
 @njit(cache=True, error_model="numpy")
-def place_sensors(x, y, heading, cos_a, sin_a, radius, sx, sy, nx, ny):
-    """Sensor positions and outward normals on a circle around (x, y)."""
-    ch, sh = np.cos(heading), np.sin(heading)
+def place_on_circle(x, y, ch, sh, cos_a, sin_a, radius, sx, sy, nx, ny):
+    """Points and outward normals on a circle around (x, y) at angles a + heading, from cos/sin of both."""
     for s in range(cos_a.shape[0]):
         nx[s] = ch * cos_a[s] - sh * sin_a[s]
         ny[s] = sh * cos_a[s] + ch * sin_a[s]
         sx[s] = x + radius * nx[s]
         sy[s] = y + radius * ny[s]
+
+
+@njit(cache=True, error_model="numpy")
+def place_sensors(x, y, heading, cos_a, sin_a, radius, sx, sy, nx, ny):
+    """Sensor positions and outward normals on a circle around (x, y)."""
+    place_on_circle(x, y, np.cos(heading), np.sin(heading), cos_a, sin_a, radius, sx, sy, nx, ny)
 
 
 @njit(cache=True, error_model="numpy")
@@ -88,10 +93,13 @@ def induced_dipoles(axy, heading, emitting, bx, by, alpha, img, c, p_ind):
 
     E_e is the field of e's two monopoles and all their wall images. Bodies are
     the innermost, contiguous loop so the sums vectorise; silent agents' rows are zero.
+    ``p_ind`` may have room for more bodies than ``bx``: its rows are sliced here, so
+    numba sees them contiguous (a slice of the last axis taken by the caller is not).
     """
     kq, soft2, one = c[K] * c[Q], c[SOFT2], c[ONE]
+    nb = bx.shape[0]
     for e in range(axy.shape[0]):
-        px, py = p_ind[e, 0], p_ind[e, 1]
+        px, py = p_ind[e, 0, :nb], p_ind[e, 1, :nb]
         px[:] = c[ZERO]
         py[:] = c[ZERO]
         if not emitting[e]:
@@ -118,22 +126,26 @@ def induced_dipoles(axy, heading, emitting, bx, by, alpha, img, c, p_ind):
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def far_readings(src, count, qx, qy, qnx, qny, c, out1, out2):
-    """E.n at the far-field points of both moment columns of ``src[:count]``.
+def far_readings(src, lo, hi, qx, qy, qnx, qny, c, out1, out2):
+    """E.n at the far-field points of both moment columns of sources ``lo:hi`` of ``src``.
 
     Loops over sources innermost, so the sums vectorise; the two moments share
-    one geometry (distance, powers) per source and point.
+    one geometry (distance, powers) per source and point. The rows are sliced
+    first so the loop index starts at 0: numba must otherwise allow for a
+    negative index at every access, which blocks vectorisation.
     """
     one, three, soft2 = c[ONE], c[THREE], c[SOFT2]
+    x, y = src[SX, lo:hi], src[SY, lo:hi]
+    m1x, m1y, m2x, m2y = src[M1X, lo:hi], src[M1Y, lo:hi], src[M2X, lo:hi], src[M2Y, lo:hi]
     for q in range(qx.shape[0]):
         acc1 = acc2 = c[ZERO]
-        for i in range(count):
-            dx = qx[q] - src[SX, i]
-            dy = qy[q] - src[SY, i]
+        for i in range(x.shape[0]):
+            dx = qx[q] - x[i]
+            dy = qy[q] - y[i]
             inv_r2 = one / (dx * dx + dy * dy + soft2)
             inv_r3 = inv_r2 * np.sqrt(inv_r2)
             d_dot_n = (dx * qnx[q] + dy * qny[q]) * three * inv_r2
-            acc1 += inv_r3 * ((src[M1X, i] * dx + src[M1Y, i] * dy) * d_dot_n - (src[M1X, i] * qnx[q] + src[M1Y, i] * qny[q]))
-            acc2 += inv_r3 * ((src[M2X, i] * dx + src[M2Y, i] * dy) * d_dot_n - (src[M2X, i] * qnx[q] + src[M2Y, i] * qny[q]))
+            acc1 += inv_r3 * ((m1x[i] * dx + m1y[i] * dy) * d_dot_n - (m1x[i] * qnx[q] + m1y[i] * qny[q]))
+            acc2 += inv_r3 * ((m2x[i] * dx + m2y[i] * dy) * d_dot_n - (m2x[i] * qnx[q] + m2y[i] * qny[q]))
         out1[q] = acc1
         out2[q] = acc2
