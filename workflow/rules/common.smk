@@ -6,7 +6,7 @@ from pathlib import Path
 from snakemake.exceptions import WorkflowError
 
 from efish.config import ConfigError, compose
-from efish.figures.registry import PANELS, figures, panels_for
+from efish.figures.registry import PANELS, panels_for
 
 SCALE = str(config.get("scale", "laptop"))
 # Extra Hydra overrides for every efish call, e.g. --config overrides="physics.tolerance=1e-6"
