@@ -7,6 +7,7 @@ from snakemake.exceptions import WorkflowError
 
 from efish.config import ConfigError, compose
 from efish.figures.registry import PANELS, panels_for
+from efish.figures.render import input_paths
 
 SCALE = str(config.get("scale", "laptop"))
 # Extra Hydra overrides for every efish call, e.g. --config overrides="physics.tolerance=1e-6"
@@ -43,12 +44,8 @@ wildcard_constraints:
 
 
 def panel_inputs(panel):
-    """Every table a panel reads, at this scale."""
-    paths = []
-    for path in panel.inputs.values():
-        rels = [path.format(seed=s) for s in SEEDS] if "{seed}" in path else [path]
-        paths += [f"results/{SCALE}/{rel}" for rel in rels]
-    return paths
+    """Every table a panel reads, at this scale (the same expansion efish figure uses)."""
+    return [str(path) for paths in input_paths(panel, Path(f"results/{SCALE}"), len(SEEDS)).values() for path in paths]
 
 
 def selected_policy(wildcards):

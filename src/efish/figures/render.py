@@ -29,7 +29,7 @@ def load_tables(panel: Panel, results: Path, seeds: int) -> dict[str, pd.DataFra
             if not path.is_file():
                 raise ValueError(f"panel {panel.key} needs {path}, which does not exist (run the pipeline first)")
             frame = pd.read_parquet(path)
-            frames.append(frame.assign(seed=seed) if len(paths) > 1 or "{seed}" in panel.inputs[name] else frame)
+            frames.append(frame.assign(seed=seed) if "{seed}" in panel.inputs[name] else frame)
         tables[name] = pd.concat(frames, ignore_index=True)
     return tables
 
