@@ -106,8 +106,8 @@ def flat_far_tables(plan: EffectPlan) -> tuple[np.ndarray, np.ndarray, np.ndarra
 
     Returns offsets (int64[L + 1], level l owns rows offsets[l]:offsets[l + 1]),
     points (2, sum Q) cos and sin of the point angles, and the interpolation
-    matrices (36, sum Q) and (24, sum Q): the interpolation of every level
-    at once is one dense matrix-vector product per receptor class.
+    matrices (sum Q, 36) and (sum Q, 24), transposed so that each point adds
+    one contiguous row to every sensor of a class.
     """
     q = np.array(plan.far_levels, dtype=np.int64)
     offsets = np.concatenate([[0], np.cumsum(q)]).astype(np.int64)
@@ -116,4 +116,4 @@ def flat_far_tables(plan: EffectPlan) -> tuple[np.ndarray, np.ndarray, np.ndarra
     points = np.concatenate([b[0] for b in blocks], axis=1) if blocks else np.zeros((2, 0))
     morm = np.concatenate([b[1] for b in blocks], axis=1) if blocks else np.zeros((len(plan.morm_angles), 0))
     amp = np.concatenate([b[2] for b in blocks], axis=1) if blocks else np.zeros((len(plan.amp_angles), 0))
-    return offsets, points, morm, amp
+    return offsets, points, np.ascontiguousarray(morm.T), np.ascontiguousarray(amp.T)

@@ -34,20 +34,6 @@ _FASTMATH = {"contract", "arcp", "reassoc"}  # no nnan/ninf: hard cases must kee
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def add_dipole(out, sx, sy, nx, ny, px, py, mx, my, soft2, one, three):
-    """out[s] += (k p-field of the dipole (mx, my) at (px, py)) . n[s]; moments carry k."""
-    for s in range(out.shape[0]):
-        dx = sx[s] - px
-        dy = sy[s] - py
-        inv_r2 = one / (dx * dx + dy * dy + soft2)
-        inv_r3 = inv_r2 * np.sqrt(inv_r2)
-        p_dot_d = mx * dx + my * dy
-        d_dot_n = dx * nx[s] + dy * ny[s]
-        p_dot_n = mx * nx[s] + my * ny[s]
-        out[s] += inv_r3 * (three * p_dot_d * d_dot_n * inv_r2 - p_dot_n)
-
-
-@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
 def add_monopole(out, sx, sy, nx, ny, px, py, kq, soft2, one):
     """out[s] += (field of charge q at (px, py)) . n[s]; kq = k * q."""
     for s in range(out.shape[0]):

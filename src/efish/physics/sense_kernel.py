@@ -26,36 +26,91 @@ from .kernels import (
     _FASTMATH, ALPHA_AGENT, ALPHA_PELLET, CULL, DO_AMP, DO_INDUCTION, DO_KNOLL, DO_MORM, DO_PELLETS,
     DO_WALLDIST, FAR_MAX_LS, FAR_MAX_LX, G_CONS, G_SELF, HALF_SEP, K, K_CONS, KNOLL_ZERO, M1X, M1Y, M2X, M2Y, N_SRC, ONE,
     P_AGENT, P_PELLET, Q, R_SENS, SOFT2, SX, SY, TOL_AMP, TOL_MORM, ZERO, ZERO_AMP, ZERO_MORM,
-    add_dipole, add_monopole, far_readings, image_table, induced_dipoles, place_on_circle, place_sensors,
+    THREE, add_monopole, far_readings, image_table, induced_dipoles, place_on_circle, place_sensors,
 )
 
 
-@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def image_bounds(ax, ay, bx, by, sig, img, r, geo):
-    """Positions, unit-moment bounds 2 w / (D - r)^3, significance and D^2 of every body image seen from (ax, ay).
+# Rows of the per-source staging array ``geo`` (float64, one column per body image).
+G_X, G_Y, G_M1X, G_M1Y, G_M2X, G_M2Y, G_LS, G_LX, G_KEEP, G_UNIT, N_GEO = range(11)
+BLOCK = 16  # sources per SIMD block: 2 AVX registers of float32, 4 of float64 (measured best)
+MITCHELL_ERROR = 0.0861  # max of log2(1 + f) - f on [0, 1]: the bit-pattern log2 is at most this low
 
-    Branch-free over bodies so it vectorises; column k = i * bodies + j of
-    ``geo`` holds rows (x, y, bound, -, bound * sig[j], D^2), where ``sig``
-    is a body's larger moment / threshold ratio, so row 4 is the source's
-    bound / threshold. A source inside the sensor circle gets a huge bound.
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def body_significance(m1x, m1y, m2x, m2y, thr1, thr2, mags):
+    """mags rows: |moment| of both columns and the larger |moment| / threshold of every body."""
+    inv1 = 1.0 / thr1 if thr1 > 0 else 0.0
+    inv2 = 1.0 / thr2 if thr2 > 0 else 0.0
+    for j in range(m1x.shape[0]):
+        mags[0, j] = np.sqrt(m1x[j] * m1x[j] + m1y[j] * m1y[j])
+        mags[1, j] = np.sqrt(m2x[j] * m2x[j] + m2y[j] * m2y[j])
+        mags[2, j] = max(mags[0, j] * inv1, mags[1, j] * inv2)  # a conservative significance
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def source_geometry(a, ax, ay, bx, by, sig, img, r, geo):
+    """Position, unit-moment bound 2 w / (D - r)^3 and D^2 of every body image seen from agent ``a``.
+
+    Column k = i * bodies + j of ``geo``; branch-free over bodies so it
+    vectorises. ``G_LS`` receives bound / threshold (``sig``: a body's larger
+    |moment| / threshold), ``G_LX`` D^2, both > 0 for their log2. The agent's
+    own body (the identity image of ``a``) gets bound 0: its own induced moment
+    is 0 and its intrinsic dipole enters through its images only.
     """
     nb = bx.shape[0]
     for i in range(img.shape[0]):
         ox, sx, oy, sy, w = img[i, 0], img[i, 1], img[i, 2], img[i, 3], img[i, 4]
         for j in range(nb):
+            k = i * nb + j
             x = ox + sx * bx[j]
             y = oy + sy * by[j]
             d2 = (x - ax) * (x - ax) + (y - ay) * (y - ay)
-            gap = max(np.sqrt(d2) - r, 1e-100)
-            unit = 2.0 * w / (gap * gap * gap)
-            geo[0, i * nb + j] = x
-            geo[1, i * nb + j] = y
-            geo[2, i * nb + j] = unit
-            geo[4, i * nb + j] = unit * sig[j] + 1e-300  # > 0: its log2 stays finite
-            geo[5, i * nb + j] = d2 + 1e-300
+            gap = max(np.sqrt(d2) - r, 1e-100)  # a source inside the sensor circle gets a huge bound
+            unit = 2.0 * w / (gap * gap * gap) * (k != a)
+            geo[G_X, k] = x
+            geo[G_Y, k] = y
+            geo[G_UNIT, k] = unit
+            geo[G_LS, k] = unit * sig[j] + 1e-300
+            geo[G_LX, k] = d2 + 1e-300
 
 
-MITCHELL_ERROR = 0.0861  # max of log2(1 + f) - f on [0, 1]: the bit-pattern log2 is at most this low
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def cull_column(a, mag, mx, my, thr, img, unit, out_x, out_y):
+    """Image moments of one column, 0 where the bound |m| * unit is below ``thr``; returns the bound sum.
+
+    ``a``'s own body is dropped (see :func:`source_geometry`).
+    """
+    nb = mag.shape[0]
+    total = 0.0  # bounds steer decisions only: float64 whatever the dtype
+    for i in range(img.shape[0]):
+        w, sx, sy = img[i, 4], img[i, 1], img[i, 3]
+        for j in range(nb):
+            k = i * nb + j
+            b = mag[j] * unit[k]
+            total += b
+            wk = w * ((mag[j] > 0) & (b >= thr) & (k != a))
+            out_x[k] = sx * wk * mx[j]
+            out_y[k] = sy * wk * my[j]
+    return total
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def stage_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, mags, img, r, thr1, thr2, geo):
+    """Every body image seen from agent ``a``: position, culled moments and bounds, in ``geo``.
+
+    A column whose bound is below its threshold is stored as 0 (culled);
+    ``G_KEEP`` is 1 where any column survives. Separate passes, each over few
+    arrays: one loop writing every row would need more runtime alias checks
+    than LLVM allows, and would stay scalar. Returns the bound sums of both columns.
+    """
+    nb = bx.shape[0]
+    n = nb * img.shape[0]
+    source_geometry(a, ax, ay, bx, by, mags[2, :nb], img, r, geo)
+    total1 = cull_column(a, mags[0, :nb], m1x, m1y, thr1, img, geo[G_UNIT], geo[G_M1X], geo[G_M1Y])
+    total2 = cull_column(a, mags[1, :nb], m2x, m2y, thr2, img, geo[G_UNIT], geo[G_M2X], geo[G_M2Y])
+    for k in range(n):
+        geo[G_KEEP, k] = (geo[G_M1X, k] != 0) | (geo[G_M1Y, k] != 0) | (geo[G_M2X, k] != 0) | (geo[G_M2Y, k] != 0)
+    return total1, total2
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
@@ -67,104 +122,107 @@ def log2_upper(values, out):
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def interpolation_levels(n, geo, level_lcq, level_e, c, out):
-    """Bucket of every source: the first level whose error bound C Q B x^e stays <= the threshold.
+def dense_level_sources(n, geo, level_lcq, level_e, c, dense):
+    """dense[k] = 1 where source k is served by the first far level, else 0.
 
-    In log2 the condition of level l is log2(C Q_l) + ls + e_l lx <= 0, with
-    upper bounds ``ls`` >= log2(bound / threshold) (from ``geo`` row 4) and
-    lx >= log2(r / D) (from ``geo`` row 5), so the choice errs towards
-    accuracy. The bound falls with the level, so the bucket is 1 + the number
-    of failing levels, or 0 (exact) when every level fails or the source is
-    closer than the far-field minimum, or so strong (bound / threshold >
+    The bound of level l is C Q_l B x^(e_l); in log2 the condition is
+    log2(C Q_l) + ls + e_l lx <= 0, with upper bounds ``ls`` >= log2(bound /
+    threshold) and lx >= log2(r / D), written over ``geo`` rows G_LS and G_LX,
+    so the choice errs towards accuracy. A source is never interpolated when it
+    is closer than the far-field minimum, or so strong (bound / threshold >
     2^FAR_MAX_LS) that float32, in which interpolated sources are evaluated,
-    would round off more than the threshold. Written as counts over levels,
-    branch-free (``|``, not ``or``), so it vectorises.
+    would round off more than the threshold. Branch-free, so it vectorises.
     """
-    n_lv = level_e.shape[0]
-    ls, lx = geo[4, :n], geo[5, :n]
+    ls, lx = geo[G_LS, :n], geo[G_LX, :n]
     log2_upper(ls, ls)
     log2_upper(lx, lx)
     log2_r = math.log2(c[R_SENS])
+    lcq, e = level_lcq[0], level_e[0]
     for k in range(n):
         lx[k] = log2_r - 0.5 * (lx[k] - MITCHELL_ERROR)
-        out[k] = 0
-    for lv in range(n_lv):  # levels outermost: the loop over sources vectorises
-        lcq, e = level_lcq[lv], level_e[lv]
-        for k in range(n):
-            out[k] += lcq + ls[k] + e * lx[k] > 0
-    for k in range(n):
-        exact = (out[k] == n_lv) | (lx[k] > c[FAR_MAX_LX]) | (ls[k] > c[FAR_MAX_LS])
-        out[k] = 0 if exact else out[k] + 1
+        near = (lx[k] > c[FAR_MAX_LX]) | (ls[k] > c[FAR_MAX_LS])
+        dense[k] = (lcq + ls[k] + e * lx[k] <= 0) & (near == 0)
+
+
+@njit(cache=True, error_model="numpy")
+def source_level(ls, lx, level_lcq, level_e, c):
+    """Bucket of a source that the first level does not serve: 1 + its level, or 0 (exact)."""
+    if (lx > c[FAR_MAX_LX]) | (ls > c[FAR_MAX_LS]):
+        return 0
+    for lv in range(1, level_e.shape[0]):
+        if level_lcq[lv] + ls + level_e[lv] * lx <= 0:
+            return lv + 1
+    return 0
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
 def gather_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, img, c, thr1, thr2, level_lcq, level_e,
-                   geo, level, keep, exact, far, offsets):
+                   mags, geo, in_dense, order, level, dense, exact, far, offsets):
     """Images of body moments whose bound at agent ``a`` reaches a threshold, bucketed by level.
 
     Column 1 (Mormyromast) and column 2 (Ampullary) are culled separately; a
-    culled column is stored as 0. The agent's own intrinsic dipole enters only
-    through its images. Bucket l holds sources ``offsets[l]:offsets[l + 1]``:
-    the exact ones (bucket 0) go to ``exact`` in the working dtype, the
-    interpolated ones straight to the same columns of ``far`` in float32,
-    positions relative to the agent (where float32 is precise). ``geo`` rows 4-5 receive upper bounds of
-    log2(bound / threshold) and log2(r / D), ``level`` the bucket of every
-    source, ``keep`` which columns survive culling. Returns the bound sums of
-    both columns.
+    culled column is stored as 0. Sources of the first far level (most of them)
+    go to ``dense`` (float32, positions relative to the agent, where float32 is
+    precise), every source in its own column with the others' moments zeroed:
+    one long loop over sources evaluates them. Only the rest, a few tens, are
+    bucketed: bucket l holds sources ``offsets[l]:offsets[l + 1]``, the exact
+    ones (bucket 0) in ``exact`` in the working dtype, those of the higher
+    levels in the same columns of ``far`` in float32 (bucket 1, the dense
+    level, stays empty). Every block is padded to a multiple of ``BLOCK`` with
+    inert sources (moment 0, 1 m away), so its loops run without a scalar
+    remainder. Returns the number of dense columns (0 without far levels) and
+    the bound sums of both columns.
     """
-    nb, n_img = bx.shape[0], img.shape[0]
-    n = nb * n_img
-    inv1 = 1.0 / thr1 if thr1 > 0 else 0.0
-    inv2 = 1.0 / thr2 if thr2 > 0 else 0.0
-    mag1, mag2, sig = np.empty(nb), np.empty(nb), np.empty(nb)
-    for j in range(nb):
-        mag1[j] = np.sqrt(m1x[j] * m1x[j] + m1y[j] * m1y[j])
-        mag2[j] = np.sqrt(m2x[j] * m2x[j] + m2y[j] * m2y[j])
-        sig[j] = max(mag1[j] * inv1, mag2[j] * inv2)  # the larger column: a conservative significance
-    image_bounds(ax, ay, bx, by, sig, img, c[R_SENS], geo)
-    level[:n] = 0
-    if level_e.shape[0] > 0:
-        interpolation_levels(n, geo, level_lcq, level_e, c, level)
-    # the agent's own intrinsic dipole enters through its images only (its own induced
-    # moment is already 0): drop the identity image, whose bound is huge (it sits on the body)
-    geo[2, a] = 0.0
-    total1 = total2 = 0.0  # bounds steer decisions only: float64 whatever the dtype
-    for i in range(n_img):  # cull, branch-free (``&``, not ``and``) so it vectorises
-        for j in range(nb):
-            k = i * nb + j
-            b1 = mag1[j] * geo[2, k]
-            b2 = mag2[j] * geo[2, k]
-            total1 += b1
-            total2 += b2
-            keep[k] = ((mag1[j] > 0) & (b1 >= thr1)) * 1 + ((mag2[j] > 0) & (b2 >= thr2)) * 2
-    keep[a] = 0
-    # counting sort by bucket: bucket l > 0 fills far[:, offsets[l]:offsets[l + 1]], one compact
-    # block that stays in L1 cache (one plane per level would spread the writes over ~100 kB)
+    nb, n = bx.shape[0], bx.shape[0] * img.shape[0]
+    body_significance(m1x, m1y, m2x, m2y, thr1, thr2, mags)
+    total1, total2 = stage_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, mags, img, c[R_SENS], thr1, thr2, geo)
+    n_levels = level_e.shape[0]
+    if n_levels > 0:
+        dense_level_sources(n, geo, level_lcq, level_e, c, in_dense)
+    else:
+        in_dense[:n] = False
+    n_dense = -(-n // BLOCK) * BLOCK if n_levels > 0 else 0
+    for k in range(n):  # branch-free, so it vectorises
+        d = in_dense[k]
+        dense[SX, k], dense[SY, k] = geo[G_X, k] - ax, geo[G_Y, k] - ay
+        dense[M1X, k], dense[M1Y, k] = geo[G_M1X, k] * d, geo[G_M1Y, k] * d
+        dense[M2X, k], dense[M2Y, k] = geo[G_M2X, k] * d, geo[G_M2Y, k] * d
+    for k in range(n, n_dense):
+        dense[SX, k], dense[SY, k] = 1.0, 0.0
+        dense[M1X, k] = dense[M1Y, k] = dense[M2X, k] = dense[M2Y, k] = 0.0
+    rest = 0
+    for k in range(n):  # branch-free compaction of the others (its own loop: the one above vectorises)
+        order[rest] = k
+        rest += (geo[G_KEEP, k] != 0) & (in_dense[k] == 0)
+    # counting sort of the others by bucket, each bucket padded to whole blocks
     offsets[:] = 0
-    for k in range(n):
-        offsets[level[k] + 1] += keep[k] != 0
+    for t in range(rest):
+        k = order[t]
+        level[t] = source_level(geo[G_LS, k], geo[G_LX, k], level_lcq, level_e, c) if n_levels > 0 else 0
+        offsets[level[t] + 1] += 1
     for lv in range(offsets.shape[0] - 1):
-        offsets[lv + 1] += offsets[lv]
+        offsets[lv + 1] = offsets[lv] + -(-offsets[lv + 1] // BLOCK) * BLOCK
     fill = offsets[:-1].copy()
-    for i in range(n_img):
-        w, sx, sy = img[i, 4], img[i, 1], img[i, 3]
-        for j in range(nb):
-            k = i * nb + j
-            if keep[k] == 0:
-                continue
-            lv = level[k]
-            q = fill[lv]
-            fill[lv] += 1
-            w1, w2 = w * (keep[k] & 1), w * (keep[k] >> 1)  # 0 for a culled column
-            if lv == 0:
-                exact[SX, q], exact[SY, q] = geo[0, k], geo[1, k]
-                exact[M1X, q], exact[M1Y, q] = sx * w1 * m1x[j], sy * w1 * m1y[j]
-                exact[M2X, q], exact[M2Y, q] = sx * w2 * m2x[j], sy * w2 * m2y[j]
-            else:
-                far[SX, q], far[SY, q] = geo[0, k] - ax, geo[1, k] - ay
-                far[M1X, q], far[M1Y, q] = sx * w1 * m1x[j], sy * w1 * m1y[j]
-                far[M2X, q], far[M2Y, q] = sx * w2 * m2x[j], sy * w2 * m2y[j]
-    return total1, total2
+    for t in range(rest):
+        k, lv = order[t], level[t]
+        q = fill[lv]
+        fill[lv] += 1
+        if lv == 0:
+            exact[SX, q], exact[SY, q] = geo[G_X, k], geo[G_Y, k]
+            exact[M1X, q], exact[M1Y, q] = geo[G_M1X, k], geo[G_M1Y, k]
+            exact[M2X, q], exact[M2Y, q] = geo[G_M2X, k], geo[G_M2Y, k]
+        else:
+            far[SX, q], far[SY, q] = geo[G_X, k] - ax, geo[G_Y, k] - ay
+            far[M1X, q], far[M1Y, q] = geo[G_M1X, k], geo[G_M1Y, k]
+            far[M2X, q], far[M2Y, q] = geo[G_M2X, k], geo[G_M2Y, k]
+    for q in range(fill[0], offsets[1]):
+        exact[SX, q], exact[SY, q] = ax + 1.0, ay
+        exact[M1X, q] = exact[M1Y, q] = exact[M2X, q] = exact[M2Y, q] = 0.0
+    for lv in range(1, offsets.shape[0] - 1):
+        for q in range(fill[lv], offsets[lv + 1]):
+            far[SX, q], far[SY, q] = 1.0, 0.0
+            far[M1X, q] = far[M1Y, q] = far[M2X, q] = far[M2Y, q] = 0.0
+    return n_dense, total1, total2
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
@@ -238,32 +296,41 @@ def knollenorgan_env(axy, heading, emitting, cos_k, sin_k, c, flags, out):
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
 def add_sources(out, src, count, col_x, col_y, sx, sy, nx, ny, c):
-    """Add the dipoles of column (col_x, col_y) of ``src[:count]`` at every sensor."""
-    for i in range(count):
-        if src[col_x, i] != 0 or src[col_y, i] != 0:
-            add_dipole(out, sx, sy, nx, ny, src[SX, i], src[SY, i], src[col_x, i], src[col_y, i],
-                       c[SOFT2], c[ONE], c[ONE] + c[ONE] + c[ONE])
+    """Add the dipoles of column (col_x, col_y) of ``src[:count]`` at every sensor.
 
-
-@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def interpolate_add(out, matrix, values):
-    """out += matrix @ values: trigonometric interpolation from the points of every level to the sensors.
-
-    ``matrix`` is (sensors, points), so each sensor is one dot product over
-    contiguous points, summed in registers (levels without sources carry zeros).
+    Sources innermost (a padded bucket: no scalar remainder), summed in registers.
     """
+    one, three, soft2 = c[ONE], c[THREE], c[SOFT2]
+    x, y, mx, my = src[SX, :count], src[SY, :count], src[col_x, :count], src[col_y, :count]
     for s in range(out.shape[0]):
-        row = matrix[s]
-        acc = out[s] - out[s]
-        for q in range(values.shape[0]):
-            acc += row[q] * values[q]
+        acc = c[ZERO]
+        for i in range(x.shape[0]):
+            dx = sx[s] - x[i]
+            dy = sy[s] - y[i]
+            inv_r2 = one / (dx * dx + dy * dy + soft2)
+            inv_r3 = inv_r2 * np.sqrt(inv_r2)
+            acc += inv_r3 * (three * (mx[i] * dx + my[i] * dy) * (dx * nx[s] + dy * ny[s]) * inv_r2
+                             - (mx[i] * nx[s] + my[i] * ny[s]))
         out[s] += acc
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def interpolate_add(out, matrix, values, lo, hi):
+    """out += matrix[lo:hi].T @ values[lo:hi]: trigonometric interpolation from one level's points to the sensors.
+
+    ``matrix`` is (points, sensors): each point adds its value times one
+    contiguous row to all sensors at once (levels hold few points, classes many sensors).
+    """
+    for q in range(lo, hi):
+        row, v = matrix[q], values[q]
+        for s in range(out.shape[0]):
+            out[s] += row[s] * v
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
 def sense_agent(a, axy, heading, emitting, bx, by, m1x, m1y, m2x, m2y, img, c, c32, flags, tables, levels,
-                level_lcq, level_e, far_offsets, far_points, interp_m, interp_a, geo, level, keep, exact, far, offsets,
-                scratch, scratch32, out_m, out_a):
+                level_lcq, level_e, far_offsets, far_points, interp_m, interp_a, mags, geo, in_dense, order, level,
+                dense, exact, far, offsets, scratch, scratch32, out_m, out_a):
     """Mormyromast and Ampullary raw readings of agent ``a``.
 
     ``tables`` rows 0-1 / 2-3: cos, sin of Mormyromast / Ampullary angles.
@@ -276,8 +343,8 @@ def sense_agent(a, axy, heading, emitting, bx, by, m1x, m1y, m2x, m2y, img, c, c
     ax, ay = axy[a, 0], axy[a, 1]
     thr1 = c[TOL_MORM] if flags[CULL] else -1.0
     thr2 = c[TOL_AMP] if flags[CULL] else -1.0
-    tot1, tot2 = gather_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, img, c, thr1, thr2, level_lcq, level_e,
-                                geo, level, keep, exact, far, offsets)
+    n_dense, tot1, tot2 = gather_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, img, c, thr1, thr2, level_lcq,
+                                         level_e, mags, geo, in_dense, order, level, dense, exact, far, offsets)
     walls = flags[DO_WALLDIST] and emitting[a] and img.shape[0] > 1 and c[G_SELF] != 0
     do_m = flags[DO_MORM] and (walls or not flags[CULL] or tot1 > c[ZERO_MORM])
     do_a = flags[DO_AMP] and (not flags[CULL] or tot2 > c[ZERO_AMP])
@@ -290,7 +357,7 @@ def sense_agent(a, axy, heading, emitting, bx, by, m1x, m1y, m2x, m2y, img, c, c
     if do_a:
         place_sensors(ax, ay, heading[a], tables[2, :sa], tables[3, :sa], c[R_SENS], sx[:sa], sy[:sa], nx[:sa], ny[:sa])
         add_sources(out_a, exact, offsets[1], M2X, M2Y, sx[:sa], sy[:sa], nx[:sa], ny[:sa], c)
-    if not (do_m or do_a) or offsets[-1] == offsets[1]:
+    if not (do_m or do_a) or (offsets[-1] == offsets[1] and n_dense == 0):
         return
     # the points of every level at once: one cos/sin of the heading per agent
     n_pts = far_offsets[-1]
@@ -299,20 +366,22 @@ def sense_agent(a, axy, heading, emitting, bx, by, m1x, m1y, m2x, m2y, img, c, c
                     far_points[0], far_points[1], c32[R_SENS], px, py, pnx, pny)
     for lv in range(levels.shape[0]):
         lo, hi = far_offsets[lv], far_offsets[lv + 1]
-        if offsets[lv + 2] == offsets[lv + 1]:
-            scratch32[4, lo:hi] = 0.0
-            scratch32[5, lo:hi] = 0.0
-            continue
         # interpolated sources are evaluated in float32 (twice the SIMD width, far
         # cheaper sqrt and division); positions relative to the agent keep it precise
-        far_readings(far, offsets[lv + 1], offsets[lv + 2], px[lo:hi], py[lo:hi], pnx[lo:hi], pny[lo:hi], c32,
-                     scratch32[4, lo:hi], scratch32[5, lo:hi])
-    scratch[4, :n_pts] = scratch32[4, :n_pts]
-    scratch[5, :n_pts] = scratch32[5, :n_pts]
-    if do_m:
-        interpolate_add(out_m, interp_m, scratch[4, :n_pts])
-    if do_a:
-        interpolate_add(out_a, interp_a, scratch[5, :n_pts])
+        if lv == 0:
+            far_readings(dense, 0, n_dense, px[lo:hi], py[lo:hi], pnx[lo:hi], pny[lo:hi], c32,
+                         scratch32[4, lo:hi], scratch32[5, lo:hi])
+        elif offsets[lv + 2] > offsets[lv + 1]:
+            far_readings(far, offsets[lv + 1], offsets[lv + 2], px[lo:hi], py[lo:hi], pnx[lo:hi], pny[lo:hi], c32,
+                         scratch32[4, lo:hi], scratch32[5, lo:hi])
+        else:
+            continue  # an empty level adds nothing
+        scratch[4, lo:hi] = scratch32[4, lo:hi]
+        scratch[5, lo:hi] = scratch32[5, lo:hi]
+        if do_m:
+            interpolate_add(out_m, interp_m, scratch[4], lo, hi)
+        if do_a:
+            interpolate_add(out_a, interp_a, scratch[5], lo, hi)
 
 
 @njit(cache=True, error_model="numpy")
@@ -327,13 +396,17 @@ def sense_batch_kernel(agent_xy, heading, emitting, pellet_xy, pellet_phi, pelle
     b_count, n = agent_xy.shape[0], agent_xy.shape[1]
     nb_max = n + (pellet_xy.shape[1] if flags[DO_PELLETS] else 0)
     cap = nb_max * img_idx.shape[0]
-    exact = np.empty((N_SRC, cap), c.dtype)
-    far = np.empty((N_SRC, cap), np.float32)
+    padded = cap + BLOCK * (levels.shape[0] + 1)  # room for every bucket's padding
+    exact = np.empty((N_SRC, padded), c.dtype)
+    far = np.empty((N_SRC, padded), np.float32)
     offsets = np.zeros(levels.shape[0] + 2, np.int64)  # bucket l: sources offsets[l]:offsets[l + 1]
     c32 = c.astype(np.float32)
-    geo = np.empty((6, cap), np.float64)
+    geo = np.empty((N_GEO, cap), np.float64)
+    mags = np.empty((3, nb_max), np.float64)
+    in_dense = np.zeros(cap, np.bool_)
+    order = np.zeros(cap, np.int64)
     level = np.zeros(cap, np.int64)
-    keep = np.zeros(cap, np.int64)
+    dense = np.empty((N_SRC, padded), np.float32)
     scratch = np.empty((6, max(tables.shape[1], far_points.shape[1])), c.dtype)
     scratch32 = np.empty((6, far_points.shape[1]), np.float32)
     p_ind = np.zeros((n, 2, nb_max), c.dtype)  # per emitter: induced moments of every body
@@ -367,6 +440,7 @@ def sense_batch_kernel(agent_xy, heading, emitting, pellet_xy, pellet_phi, pelle
                 body[4, :nb] = c[ZERO]
             sense_agent(a, agent_xy[b], heading[b], emitting[b], body[0, :nb], body[1, :nb], body[3, :nb],
                         body[4, :nb], body[5, :nb], body[6, :nb], img, c, c32, flags, tables, levels, level_lcq, level_e, far_offsets, far_points,
-                        interp_m, interp_a, geo, level, keep, exact, far, offsets, scratch, scratch32, out_m[b, a], out_a[b, a])
+                        interp_m, interp_a, mags, geo, in_dense, order, level, dense, exact, far, offsets, scratch, scratch32,
+                        out_m[b, a], out_a[b, a])
         if flags[DO_KNOLL]:
             knollenorgan_env(agent_xy[b], heading[b], emitting[b], cos_k, sin_k, c, flags, out_k[b])
