@@ -52,7 +52,8 @@ class PhysicsConfig:
     induction: bool = param(True, "bodies are polarised by EOD fields (induced dipoles)")
     tolerance: float = param(1e-7, "skip a source when a bound on its field is below tolerance * E_min; 0 = exact", lo=0.0, hi=1e3)
     dtype: str = param("float64", "floating type of the field kernels", choices=("float64", "float32"))
-    far_field_levels: list = param([3, 5, 7, 9, 13, 17, 21, 31], "point counts (odd) a distant source may be interpolated from; [] = off")
+    far_field_levels: list = param([13, 31], "point counts (odd, increasing) a distant source may be interpolated "
+                                   "from; the first is evaluated densely over all sources; [] = off")
     far_field_min_cm: float = param(3.0, "sources closer than this are always evaluated at every sensor, cm", lo=1.0)
     far_field_safety: float = param(100.0, "C in the interpolation error model C * Q * B * (r/D)^((Q+1)/2)", lo=1.0)
 
