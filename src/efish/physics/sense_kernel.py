@@ -35,6 +35,7 @@ from .kernels import (
     P_AGENT, P_PELLET, Q, R_SENS, SOFT2, SX, SY, TOL_AMP, TOL_MORM, ZERO, ZERO_AMP, ZERO_MORM,
     THREE, add_monopole, far_readings, image_table, induced_dipoles, place_on_circle, place_sensors,
 )
+from .trig import sincos
 
 
 # Rows of the per-source staging array ``geo`` (float64, one column per body image).
@@ -398,10 +399,11 @@ def sense_batch_kernel(agent_xy, heading, emitting, pellet_xy, pellet_phi, pelle
                        out_m, out_a, out_k):
     """Raw readings for B arenas. Positions in m, in the dtype of ``c``; outputs zeroed by the caller.
 
-    Bodies are the agents (first N) then the live pellets of each arena.
+    Bodies are the agents (first N), then the live pellets of each arena, then inert padding.
     """
     b_count, n = agent_xy.shape[0], agent_xy.shape[1]
     nb_max = n + (pellet_xy.shape[1] if flags[DO_PELLETS] else 0)
+    nb_max = -(-nb_max // BLOCK) * BLOCK  # room for the inert padding bodies
     cap = nb_max * img_idx.shape[0]
     padded = cap + BLOCK * (levels.shape[0] + 1)  # room for every bucket's padding
     exact = np.empty((N_SRC, padded), c.dtype)
@@ -418,20 +420,33 @@ def sense_batch_kernel(agent_xy, heading, emitting, pellet_xy, pellet_phi, pelle
     scratch32 = np.empty((6, far_points.shape[1]), np.float32)
     p_ind = np.zeros((n, 2, nb_max), c.dtype)  # per emitter: induced moments of every body
     body = np.empty((7, nb_max), c.dtype)  # x, y, alpha, m1x, m1y, m2x, m2y
+    # sin and cos of every heading and pellet orientation, vectorised (libm's are scalar calls)
+    angles = np.empty(n + pellet_xy.shape[1])
+    sin_t, cos_t = np.empty_like(angles), np.empty_like(angles)
     for b in range(b_count):
         img = image_table(width[b], height[b], img_idx, img_w, c)
+        if flags[DO_AMP]:
+            angles[:n] = heading[b]
+            angles[n:] = pellet_phi[b]
+            sincos(angles, sin_t, cos_t)
         nb = 0
         for j in range(n):
             body[0, nb], body[1, nb], body[2, nb] = agent_xy[b, j, 0], agent_xy[b, j, 1], c[ALPHA_AGENT]
-            body[5, nb] = c[K] * c[P_AGENT] * np.cos(heading[b, j]) if flags[DO_AMP] else c[ZERO]
-            body[6, nb] = c[K] * c[P_AGENT] * np.sin(heading[b, j]) if flags[DO_AMP] else c[ZERO]
+            body[5, nb] = c[K] * c[P_AGENT] * cos_t[j] if flags[DO_AMP] else c[ZERO]
+            body[6, nb] = c[K] * c[P_AGENT] * sin_t[j] if flags[DO_AMP] else c[ZERO]
             nb += 1
-        for j in range(nb_max - n):
+        for j in range(pellet_xy.shape[1] if flags[DO_PELLETS] else 0):
             if pellet_alive[b, j]:
                 body[0, nb], body[1, nb], body[2, nb] = pellet_xy[b, j, 0], pellet_xy[b, j, 1], c[ALPHA_PELLET]
-                body[5, nb] = -c[K] * c[P_PELLET] * np.sin(pellet_phi[b, j]) if flags[DO_AMP] else c[ZERO]
-                body[6, nb] = c[K] * c[P_PELLET] * np.cos(pellet_phi[b, j]) if flags[DO_AMP] else c[ZERO]
+                body[5, nb] = -c[K] * c[P_PELLET] * sin_t[n + j] if flags[DO_AMP] else c[ZERO]
+                body[6, nb] = c[K] * c[P_PELLET] * cos_t[n + j] if flags[DO_AMP] else c[ZERO]
                 nb += 1
+        # pad to whole SIMD blocks with inert bodies (no polarisability, no moment, 100 m away):
+        # every loop over bodies then runs without a scalar remainder
+        for j in range(nb, -(-nb // BLOCK) * BLOCK):
+            body[0, j], body[1, j] = 100.0, 100.0
+            body[2:, j] = c[ZERO]
+        nb = -(-nb // BLOCK) * BLOCK
         induction = False
         if flags[DO_INDUCTION]:
             for e in range(n):
