@@ -181,8 +181,8 @@ def gather_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, img, c, thr1, thr2, le
     levels in the same columns of ``far`` in float32 (bucket 1, the dense
     level, stays empty). Every bucket is padded with inert sources (moment 0,
     1 m away) to a multiple of ``EXACT_BLOCK`` (bucket 0) or ``BLOCK``, so its
-    loops run without a scalar remainder. Returns the number of dense columns (0 without far levels) and
-    the bound sums of both columns.
+    loops run without a scalar remainder. Returns the number of dense columns
+    (0 without far levels) and the bound sums of both columns.
     """
     n = bx.shape[0] * img.shape[0]
     body_significance(m1x, m1y, m2x, m2y, thr1, thr2, mags)
