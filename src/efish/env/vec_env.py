@@ -38,10 +38,6 @@ _DERIVED = ("cfg", "plan", "params", "muted", "frozen", "bots", "homing", "targe
             "_noise_u")
 
 
-def _sigmoid(x: np.ndarray) -> np.ndarray:
-    return 0.5 * (1.0 + np.tanh(0.5 * x))  # overflow-free logistic
-
-
 class VecEnv:
     """B foraging environments with N agents each, stepped together.
 
@@ -172,22 +168,20 @@ class VecEnv:
         actions = np.asarray(actions, dtype=np.float64)
         if actions.shape != (self.num_envs, self.n, 4):
             raise ValueError(f"actions must have shape ({self.num_envs}, {self.n}, 4), got {actions.shape}")
-        if not np.all(np.isfinite(actions)):
+        shape = (self.num_envs, self.n)
+        move, turn = np.empty(shape), np.empty(shape)  # kernel-filled
+        eod, bite, no_eating = np.empty(shape, bool), np.empty(shape, bool), np.empty(shape, bool)
+        if not dyn.map_actions(actions, self.bots, self.muted, self.target, self.homing, move, turn, eod, bite,
+                               no_eating):
             raise ValueError("actions contain NaN or infinite values")
         e = self.cfg.env
         # 1. food dynamics
         self._food_dynamics()
-        # 2. map actions (bots and the homing target override theirs), eat, move
-        move, turn = _sigmoid(actions[..., 0]), np.tanh(actions[..., 1])
-        eod = actions[..., 2] > 0.5
-        bite = (actions[..., 3] > 0.5) & ~self.bots & (not self.homing)
+        # 2. map actions (above; bots override theirs), eat, move
         if self.bots.any():
             self._drive_bots(move, turn, eod)
-        eod = (eod & ~self.muted) | self.target
         old_xy = self.xy.copy()
-        shape = (self.num_envs, self.n)
         ate, collided, can_bite = np.empty(shape, bool), np.empty(shape, bool), np.empty(shape, bool)  # kernel-filled
-        no_eating = bite | self.bots[None, :]  # bots never eat: they enter the kernel as if biting
         dyn.eat_and_move(self.xy, self.heading, self.eat_cd, self.bite_cd, move, turn, no_eating, self._v_max,
                          self._w_max, self.pellet_xy, self.alive, self.width, self.height, self.params,
                          ate, collided, can_bite)
@@ -275,7 +269,7 @@ class VecEnv:
             centre = np.array([self.width[b], self.height[b]]) / 2
             m, t, f = bot_actions(self.xy[b, ids], self.heading[b, ids], w_max[b, ids], centre, e.bot_radius_cm,
                                   e.bot_eod_rate, self.rngs[b])
-            move[b, ids], turn[b, ids], eod[b, ids] = m, t, f
+            move[b, ids], turn[b, ids], eod[b, ids] = m, t, (f & ~self.muted[ids]) | self.target[ids]
 
     def _perceive(self, eod: np.ndarray, out: np.ndarray) -> None:
         """Write the sensory part of the observation into ``out[..., :perception_width]``: receptors or rays."""

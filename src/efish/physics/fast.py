@@ -82,8 +82,11 @@ def fast_raw(batch: SnapshotBatch, plan: EffectPlan) -> RawReadings:
         return out
     emitting = np.ascontiguousarray(batch.agent_emitting & plan.on("eod_emission"))
 
-    def arr(x, scale=1.0):
-        return np.ascontiguousarray(np.asarray(x, dtype=np.float64) * scale, dtype=dtype)
+    def arr(x, scale=None):  # the input itself when it already fits; scaled in float64, then cast
+        if scale is None:
+            return np.ascontiguousarray(x, dtype=dtype)
+        scaled = np.multiply(x, scale, dtype=np.float64, order="C")
+        return scaled if dtype == np.float64 else scaled.astype(dtype)
 
     sense_batch_kernel(
         arr(batch.agent_xy, CM), arr(batch.agent_heading), emitting,

@@ -69,6 +69,27 @@ def noise_draw_count(raw: RawReadings) -> int:
     return raw.mormyromast.size + 2 * raw.ampullary.size + raw.knollenorgan.size
 
 
+@njit(cache=True, error_model="numpy")
+def clip_noisy(s, u, lo, scale, e_min, e_max, mag, sgn):
+    """mag = clip(|s * f|, e_min, e_max), sgn = sign(s * f) with f = lo + scale * u (f = 1 when ``u`` is empty).
+
+    One agent's row of one receptor class: contiguous 1-D arrays and no
+    branches in the loop, so it vectorises. The factor is rounded to the raw
+    dtype before multiplying, as numpy's ``astype`` does in ``apply_noise``.
+    """
+    as_raw = s.dtype.type
+    if u.shape[0] == 0:
+        for k in range(s.shape[0]):
+            v = np.float64(s[k])
+            mag[k] = min(max(abs(v), e_min), e_max)
+            sgn[k] = np.sign(v)
+    else:
+        for k in range(s.shape[0]):
+            v = np.float64(s[k] * as_raw(lo + scale * u[k]))
+            mag[k] = min(max(abs(v), e_min), e_max)
+            sgn[k] = np.sign(v)
+
+
 @njit(cache=True)
 def noisy_kernel(morm, amp, knoll, u, emitting, size, lin, typed, flags, slots, mag, sgn, out):
     """Noise on every reading; Knollenorgan spikes and size channels into ``out``; log inputs into ``mag``/``sgn``.
@@ -85,6 +106,7 @@ def noisy_kernel(morm, amp, knoll, u, emitting, size, lin, typed, flags, slots, 
     noisy, knoll_on = flags[NOISE] != 0, flags[KNOLL_ON] != 0
     as_raw = morm.dtype.type  # rounds a float64 factor to the raw dtype, as numpy's astype does
     u_amp, u_jam, u_knoll = morm.size, morm.size + amp.size, morm.size + 2 * amp.size
+    none = u[:0]
     k0 = n_m + n_a
     s0 = k0 + slots * n_k
     for b in range(b_count):
@@ -93,22 +115,15 @@ def noisy_kernel(morm, amp, knoll, u, emitting, size, lin, typed, flags, slots, 
             emitters += emitting[b, j]
         for i in range(n):
             row = b * n + i
-            for k in range(n_m):
-                s = morm[b, i, k]
-                if noisy:
-                    s = s * as_raw(lin[LO] + lin[SCALE] * u[row * n_m + k])
-                mag[b, i, k] = min(max(abs(np.float64(s)), lin[M_EMIN]), lin[M_EMAX])
-                sgn[b, i, k] = np.sign(np.float64(s))
-            jammed = emitters - emitting[b, i] > 0  # a conspecific emits: EOD interference
-            for k in range(n_a):
-                s = amp[b, i, k]
-                if noisy:
-                    if jammed:
-                        s = s * as_raw(lin[JAM_LO] + lin[JAM_SCALE] * u[u_jam + row * n_a + k])
-                    else:
-                        s = s * as_raw(lin[LO] + lin[SCALE] * u[u_amp + row * n_a + k])
-                mag[b, i, n_m + k] = min(max(abs(np.float64(s)), lin[A_EMIN]), lin[A_EMAX])
-                sgn[b, i, n_m + k] = np.sign(np.float64(s))
+            mag_row, sgn_row = mag[b, i], sgn[b, i]
+            clip_noisy(morm[b, i], u[row * n_m:(row + 1) * n_m] if noisy else none, lin[LO], lin[SCALE],
+                       lin[M_EMIN], lin[M_EMAX], mag_row[:n_m], sgn_row[:n_m])
+            if emitters - emitting[b, i] > 0:  # a conspecific emits: EOD interference
+                lo, scale, first = lin[JAM_LO], lin[JAM_SCALE], u_jam + row * n_a
+            else:
+                lo, scale, first = lin[LO], lin[SCALE], u_amp + row * n_a
+            clip_noisy(amp[b, i], u[first:first + n_a] if noisy else none, lo, scale, lin[A_EMIN], lin[A_EMAX],
+                       mag_row[n_m:], sgn_row[n_m:])
             for j in range(slots):
                 heard = False
                 for k in range(n_k):
@@ -127,6 +142,13 @@ def noisy_kernel(morm, amp, knoll, u, emitting, size, lin, typed, flags, slots, 
                     out[b, i, s0 + j] = 0.0
 
 
+@njit(cache=True, error_model="numpy")
+def scale_log(log_mag, sgn, l_min, span, out):
+    """out = sgn * (log_mag - l_min) / span, rounded to float32: one row, vectorised."""
+    for k in range(out.shape[0]):
+        out[k] = sgn[k] * (log_mag[k] - l_min) / span
+
+
 @njit(cache=True)
 def log_kernel(log_mag, sgn, n_m, lin, flags, out):
     """Mormyromast and Ampullary readings into ``out[..., :M + A]`` from log10 of the clipped magnitude.
@@ -134,13 +156,18 @@ def log_kernel(log_mag, sgn, n_m, lin, flags, out):
     y = sign(s) * (log10 m - log10 E_min) / (log10 E_max - log10 E_min), the
     operations and order of ``log_normalize``; disabled classes read 0.
     """
-    blocks = ((0, n_m, flags[MORM_ON], lin[M_LMIN], lin[M_SPAN]),
-              (n_m, log_mag.shape[2], flags[AMP_ON], lin[A_LMIN], lin[A_SPAN]))
-    for start, stop, on, l_min, span in blocks:
-        for b in range(out.shape[0]):
-            for i in range(out.shape[1]):
-                for k in range(start, stop):
-                    out[b, i, k] = sgn[b, i, k] * (log_mag[b, i, k] - l_min) / span if on else 0.0
+    n_ma = log_mag.shape[2]
+    for b in range(out.shape[0]):
+        for i in range(out.shape[1]):
+            row = out[b, i]
+            if flags[MORM_ON]:
+                scale_log(log_mag[b, i, :n_m], sgn[b, i, :n_m], lin[M_LMIN], lin[M_SPAN], row[:n_m])
+            else:
+                row[:n_m] = 0.0
+            if flags[AMP_ON]:
+                scale_log(log_mag[b, i, n_m:], sgn[b, i, n_m:], lin[A_LMIN], lin[A_SPAN], row[n_m:n_ma])
+            else:
+                row[n_m:n_ma] = 0.0
 
 
 def encode_readings(raw: RawReadings, u: np.ndarray | None, emitting: np.ndarray, size: np.ndarray,
