@@ -1,8 +1,9 @@
-"""Per-agent assembly of raw readings in numba: culling, exact and interpolated sources.
+"""Per-agent assembly of raw readings in numba: exact and interpolated sources, Knollenorgans.
 
-For each agent the sources (every body and its wall images) are gathered once
-with two moment columns, the combined Mormyromast moment and the intrinsic
-(Ampullary) moment, culled by the bound of :mod:`efish.physics.plan`.
+Sources (every body and its wall images) carry two moment columns, the
+combined Mormyromast moment and the intrinsic (Ampullary) moment; which are
+culled, shared between agents or evaluated exactly is decided in
+:mod:`efish.physics.sources` by the bound of :mod:`efish.physics.plan`.
 
 With culling on (tolerance > 0) a source at distance D is not evaluated at
 every sensor when that is not needed: the reading of a dipole on the sensor
@@ -35,206 +36,19 @@ from .kernels import (
     P_AGENT, P_PELLET, Q, R_SENS, SOFT2, SX, SY, THREE, TOL_AMP, TOL_MORM, ZERO, ZERO_AMP, ZERO_MORM,
     add_monopole, far_readings, image_table, induced_dipoles, place_on_circle, place_sensors,
 )
+from .sources import (
+    BLOCK, N_GEO, N_LIST, N_SHARED, copy_shared, gather_sources, imaged_moments, list_images,
+    share_far_sources, weighted_moments,
+)
 from .trig import sincos
 
 
-# Rows of the per-source staging array ``geo`` (float64, one column per body image).
-G_X, G_Y, G_M1X, G_M1Y, G_M2X, G_M2Y, G_LS, G_LX, G_KEEP, G_UNIT, N_GEO = range(11)
-# Sources per SIMD block, measured best: float32 loops over 24 sources take longer than over 32
-# (a scalar remainder), float64 loops over sensors x sources pay per 8 sources.
-BLOCK = 16
-EXACT_BLOCK = 8
-MITCHELL_ERROR = 0.0861  # max of log2(1 + f) - f on [0, 1]: the bit-pattern log2 is at most this low
-
-
-@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def body_significance(m1x, m1y, m2x, m2y, thr1, thr2, mags):
-    """mags rows: |moment| of both columns and the larger |moment| / threshold of every body."""
-    inv1 = 1.0 / thr1 if thr1 > 0 else 0.0
-    inv2 = 1.0 / thr2 if thr2 > 0 else 0.0
-    for j in range(m1x.shape[0]):
-        mags[0, j] = np.sqrt(m1x[j] * m1x[j] + m1y[j] * m1y[j])
-        mags[1, j] = np.sqrt(m2x[j] * m2x[j] + m2y[j] * m2y[j])
-        mags[2, j] = max(mags[0, j] * inv1, mags[1, j] * inv2)  # a conservative significance
-
-
-@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def source_geometry(a, ax, ay, bx, by, sig, img, r, geo):
-    """Position, unit-moment bound 2 w / (D - r)^3 and D^2 of every body image seen from agent ``a``.
-
-    Column k = i * bodies + j of ``geo``; branch-free over bodies so it
-    vectorises. ``G_LS`` receives bound / threshold (``sig``: a body's larger
-    |moment| / threshold), ``G_LX`` D^2, both > 0 for their log2. The agent's
-    own body (the identity image of ``a``) gets bound 0: its own induced moment
-    is 0 and its intrinsic dipole enters through its images only.
-    """
-    nb = bx.shape[0]
-    for i in range(img.shape[0]):
-        ox, sx, oy, sy, w = img[i, 0], img[i, 1], img[i, 2], img[i, 3], img[i, 4]
-        for j in range(nb):
-            k = i * nb + j
-            x = ox + sx * bx[j]
-            y = oy + sy * by[j]
-            d2 = (x - ax) * (x - ax) + (y - ay) * (y - ay)
-            gap = max(np.sqrt(d2) - r, 1e-100)  # a source inside the sensor circle gets a huge bound
-            unit = 2.0 * w / (gap * gap * gap) * (k != a)
-            geo[G_X, k] = x
-            geo[G_Y, k] = y
-            geo[G_UNIT, k] = unit
-            geo[G_LS, k] = unit * sig[j] + 1e-300
-            geo[G_LX, k] = d2 + 1e-300
-
-
-@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def cull_column(a, mag, mx, my, thr, img, unit, out_x, out_y):
-    """Image moments of one column, 0 where the bound |m| * unit is below ``thr``; returns the bound sum.
-
-    ``a``'s own body is dropped (see :func:`source_geometry`).
-    """
-    nb = mag.shape[0]
-    total = 0.0  # bounds steer decisions only: float64 whatever the dtype
-    for i in range(img.shape[0]):
-        w, sx, sy = img[i, 4], img[i, 1], img[i, 3]
-        for j in range(nb):
-            k = i * nb + j
-            b = mag[j] * unit[k]
-            total += b
-            wk = w * ((mag[j] > 0) & (b >= thr) & (k != a))
-            out_x[k] = sx * wk * mx[j]
-            out_y[k] = sy * wk * my[j]
-    return total
-
-
-@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def stage_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, mags, img, r, thr1, thr2, geo):
-    """Every body image seen from agent ``a``: position, culled moments and bounds, in ``geo``.
-
-    A column whose bound is below its threshold is stored as 0 (culled);
-    ``G_KEEP`` is 1 where any column survives. Separate passes, each over few
-    arrays: one loop writing every row would need more runtime alias checks
-    than LLVM allows, and would stay scalar. Returns the bound sums of both columns.
-    """
-    nb = bx.shape[0]
-    n = nb * img.shape[0]
-    source_geometry(a, ax, ay, bx, by, mags[2, :nb], img, r, geo)
-    total1 = cull_column(a, mags[0, :nb], m1x, m1y, thr1, img, geo[G_UNIT], geo[G_M1X], geo[G_M1Y])
-    total2 = cull_column(a, mags[1, :nb], m2x, m2y, thr2, img, geo[G_UNIT], geo[G_M2X], geo[G_M2Y])
-    for k in range(n):
-        geo[G_KEEP, k] = (geo[G_M1X, k] != 0) | (geo[G_M1Y, k] != 0) | (geo[G_M2X, k] != 0) | (geo[G_M2Y, k] != 0)
-    return total1, total2
-
-
-@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def log2_upper(values, out):
-    """out >= log2(values) within 0.09, from the float bit pattern (Mitchell); vectorises, no libm call."""
-    bits = values.view(np.int64)
-    for k in range(values.shape[0]):
-        out[k] = bits[k] * 2.0 ** -52 - 1023.0 + MITCHELL_ERROR
-
-
-@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def dense_level_sources(n, geo, level_lcq, level_e, c, dense):
-    """dense[k] = 1 where source k is served by the first far level, else 0.
-
-    The bound of level l is C Q_l B x^(e_l); in log2 the condition is
-    log2(C Q_l) + ls + e_l lx <= 0, with upper bounds ``ls`` >= log2(bound /
-    threshold) and lx >= log2(r / D), written over ``geo`` rows G_LS and G_LX,
-    so the choice errs towards accuracy. A source is never interpolated when it
-    is closer than the far-field minimum, or so strong (bound / threshold >
-    2^FAR_MAX_LS) that float32, in which interpolated sources are evaluated,
-    would round off more than the threshold. Branch-free, so it vectorises.
-    """
-    ls, lx = geo[G_LS, :n], geo[G_LX, :n]
-    log2_upper(ls, ls)
-    log2_upper(lx, lx)
-    log2_r = math.log2(c[R_SENS])
-    lcq, e = level_lcq[0], level_e[0]
-    for k in range(n):
-        lx[k] = log2_r - 0.5 * (lx[k] - MITCHELL_ERROR)
-        near = (lx[k] > c[FAR_MAX_LX]) | (ls[k] > c[FAR_MAX_LS])
-        dense[k] = (lcq + ls[k] + e * lx[k] <= 0) & (near == 0)
-
-
-@njit(cache=True, error_model="numpy")
-def source_level(ls, lx, level_lcq, level_e, c):
-    """Bucket of a source that the first level does not serve: 1 + its level, or 0 (exact)."""
-    if (lx > c[FAR_MAX_LX]) | (ls > c[FAR_MAX_LS]):
-        return 0
-    for lv in range(1, level_e.shape[0]):
-        if level_lcq[lv] + ls + level_e[lv] * lx <= 0:
-            return lv + 1
-    return 0
-
-
-@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def gather_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, img, c, thr1, thr2, level_lcq, level_e,
-                   mags, geo, in_dense, order, level, dense, exact, far, offsets):
-    """Images of body moments whose bound at agent ``a`` reaches a threshold, bucketed by level.
-
-    Column 1 (Mormyromast) and column 2 (Ampullary) are culled separately; a
-    culled column is stored as 0. Sources of the first far level (most of them)
-    go to ``dense`` (float32, positions relative to the agent, where float32 is
-    precise), every source in its own column with the others' moments zeroed:
-    one long loop over sources evaluates them. Only the rest, a few tens, are
-    bucketed: bucket l holds sources ``offsets[l]:offsets[l + 1]``, the exact
-    ones (bucket 0) in ``exact`` in the working dtype, those of the higher
-    levels in the same columns of ``far`` in float32 (bucket 1, the dense
-    level, stays empty). Every bucket is padded with inert sources (moment 0,
-    1 m away) to a multiple of ``EXACT_BLOCK`` (bucket 0) or ``BLOCK``, so its
-    loops run without a scalar remainder. Returns the number of dense columns
-    (0 without far levels) and the bound sums of both columns.
-    """
-    n = bx.shape[0] * img.shape[0]
-    body_significance(m1x, m1y, m2x, m2y, thr1, thr2, mags)
-    total1, total2 = stage_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, mags, img, c[R_SENS], thr1, thr2, geo)
-    n_levels = level_e.shape[0]
-    if n_levels > 0:
-        dense_level_sources(n, geo, level_lcq, level_e, c, in_dense)
-    else:
-        in_dense[:n] = False
-    n_dense = -(-n // BLOCK) * BLOCK if n_levels > 0 else 0
-    for k in range(n):  # branch-free, so it vectorises
-        d = in_dense[k]
-        dense[SX, k], dense[SY, k] = geo[G_X, k] - ax, geo[G_Y, k] - ay
-        dense[M1X, k], dense[M1Y, k] = geo[G_M1X, k] * d, geo[G_M1Y, k] * d
-        dense[M2X, k], dense[M2Y, k] = geo[G_M2X, k] * d, geo[G_M2Y, k] * d
-    for k in range(n, n_dense):
-        dense[SX, k], dense[SY, k] = 1.0, 0.0
-        dense[M1X, k] = dense[M1Y, k] = dense[M2X, k] = dense[M2Y, k] = 0.0
-    rest = 0
-    for k in range(n):  # branch-free compaction of the others (its own loop: the one above vectorises)
-        order[rest] = k
-        rest += (geo[G_KEEP, k] != 0) & (in_dense[k] == 0)
-    # counting sort of the others by bucket, each bucket padded to whole blocks
-    offsets[:] = 0
-    for t in range(rest):
-        k = order[t]
-        level[t] = source_level(geo[G_LS, k], geo[G_LX, k], level_lcq, level_e, c) if n_levels > 0 else 0
-        offsets[level[t] + 1] += 1
-    for lv in range(offsets.shape[0] - 1):
-        block = EXACT_BLOCK if lv == 0 else BLOCK
-        offsets[lv + 1] = offsets[lv] + -(-offsets[lv + 1] // block) * block
-    fill = offsets[:-1].copy()
-    for t in range(rest):
-        k, lv = order[t], level[t]
-        q = fill[lv]
-        fill[lv] += 1
-        if lv == 0:
-            exact[SX, q], exact[SY, q] = geo[G_X, k], geo[G_Y, k]
-            exact[M1X, q], exact[M1Y, q] = geo[G_M1X, k], geo[G_M1Y, k]
-            exact[M2X, q], exact[M2Y, q] = geo[G_M2X, k], geo[G_M2Y, k]
-        else:
-            far[SX, q], far[SY, q] = geo[G_X, k] - ax, geo[G_Y, k] - ay
-            far[M1X, q], far[M1Y, q] = geo[G_M1X, k], geo[G_M1Y, k]
-            far[M2X, q], far[M2Y, q] = geo[G_M2X, k], geo[G_M2Y, k]
-    for q in range(fill[0], offsets[1]):
-        exact[SX, q], exact[SY, q] = ax + 1.0, ay
-        exact[M1X, q] = exact[M1Y, q] = exact[M2X, q] = exact[M2Y, q] = 0.0
-    for lv in range(1, offsets.shape[0] - 1):
-        for q in range(fill[lv], offsets[lv + 1]):
-            far[SX, q], far[SY, q] = 1.0, 0.0
-            far[M1X, q] = far[M1Y, q] = far[M2X, q] = far[M2Y, q] = 0.0
-    return n_dense, total1, total2
+@njit(cache=True)
+def mormyromast_weights(a, emitting, c):
+    """(w_self, w_cons): weights of the self and cons induced moments in agent ``a``'s Mormyromast moment
+    (k folded in); cons carries k_cons when ``a`` is silent or g_self = 0 (SPEC 3.1)."""
+    gain = c[K_CONS] if (not emitting[a] or c[G_SELF] == 0) else c[ONE]
+    return c[G_SELF] * c[K], c[G_CONS] * gain * c[K]
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
@@ -249,9 +63,7 @@ def mormyromast_moments(a, emitting, p_ind, c, mx, my):
     float32 by up to ~0.3 after normalisation, times k_cons in cons-only runs).
     ``p_ind`` may have room for more bodies than ``mx``; rows are sliced to fit.
     """
-    gain = c[K_CONS] if (not emitting[a] or c[G_SELF] == 0) else c[ONE]
-    w_cons = c[G_CONS] * gain * c[K]
-    w_self = c[G_SELF] * c[K]
+    w_self, w_cons = mormyromast_weights(a, emitting, c)
     nb = mx.shape[0]
     sx, sy = p_ind[a, 0, :nb], p_ind[a, 1, :nb]
     for j in range(nb):
@@ -340,11 +152,16 @@ def interpolate_add(out, matrix, values, lo, hi):
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def sense_agent(a, axy, heading, emitting, bx, by, m1x, m1y, m2x, m2y, img, c, c32, flags, tables, levels,
-                level_lcq, level_e, far_offsets, far_points, interp_m, interp_a, mags, geo, in_dense, order, level,
-                dense, exact, far, offsets, scratch, scratch32, out_m, out_a):
+def sense_agent(a, axy, heading, emitting, n_list, lst, own, n_shared, shared_tot, img, c, c32, flags, tables,
+                levels, level_lcq, level_e, far_offsets, far_points, interp_m, interp_a, geo, in_dense, order, dense,
+                exact, far, offsets, scratch, scratch32, out_m, out_a):
     """Mormyromast and Ampullary raw readings of agent ``a``.
 
+    The first ``n_list`` columns of ``lst`` and ``own`` list the sources that
+    are not shared, with ``a``'s Mormyromast moments in ``geo`` (see
+    :func:`efish.physics.sources.gather_sources`); ``dense[:, :n_shared]``
+    holds the shared ones as ``a`` evaluates them, ``shared_tot`` their bound
+    sums in both columns.
     ``tables`` rows 0-1 / 2-3: cos, sin of Mormyromast / Ampullary angles.
     ``scratch`` rows 0-3: sensor x, y, nx, ny; rows 4-5: readings at the points of
     every level (``scratch32``: the same in float32 for the interpolated sources,
@@ -355,8 +172,10 @@ def sense_agent(a, axy, heading, emitting, bx, by, m1x, m1y, m2x, m2y, img, c, c
     ax, ay = axy[a, 0], axy[a, 1]
     thr1 = c[TOL_MORM] if flags[CULL] else -1.0
     thr2 = c[TOL_AMP] if flags[CULL] else -1.0
-    n_dense, tot1, tot2 = gather_sources(a, ax, ay, bx, by, m1x, m1y, m2x, m2y, img, c, thr1, thr2, level_lcq,
-                                         level_e, mags, geo, in_dense, order, level, dense, exact, far, offsets)
+    n_dense, tot1, tot2 = gather_sources(a, n_list, ax, ay, lst, own, thr1, thr2, c, level_lcq, level_e, n_shared,
+                                         geo, in_dense, order, dense, exact, far, offsets)
+    tot1 += shared_tot[0]
+    tot2 += shared_tot[1]
     walls = flags[DO_WALLDIST] and emitting[a] and img.shape[0] > 1 and c[G_SELF] != 0
     do_m = flags[DO_MORM] and (walls or not flags[CULL] or tot1 > c[ZERO_MORM])
     do_a = flags[DO_AMP] and (not flags[CULL] or tot2 > c[ZERO_AMP])
@@ -403,7 +222,11 @@ def sense_batch_kernel(agent_xy, heading, emitting, pellet_xy, pellet_phi, pelle
                        out_m, out_a, out_k):
     """Raw readings for B arenas. Positions in m, in the dtype of ``c``; outputs zeroed by the caller.
 
-    Bodies are the agents (first N), then the live pellets of each arena, then inert padding.
+    Bodies are the agents (first N), then the live pellets of each arena, then
+    inert padding. Their images are listed once per arena; when every agent
+    weighs self and cons induced moments alike (g_self = g_cons), the pellet
+    images far from every agent are shared by all agents
+    (:func:`efish.physics.sources.share_far_sources`).
     """
     b_count, n = agent_xy.shape[0], agent_xy.shape[1]
     nb_max = n + (pellet_xy.shape[1] if flags[DO_PELLETS] else 0)
@@ -414,19 +237,23 @@ def sense_batch_kernel(agent_xy, heading, emitting, pellet_xy, pellet_phi, pelle
     far = np.empty((N_SRC, padded), np.float32)
     offsets = np.zeros(levels.shape[0] + 2, np.int64)  # bucket l: sources offsets[l]:offsets[l + 1]
     c32 = c.astype(np.float32)
+    lst, rest = np.empty((N_LIST, cap), np.float64), np.empty((N_LIST, cap), np.float64)
+    own, owner = np.empty(cap, np.int64), np.empty(cap, np.int64)
+    rest_own, rest_owner = np.empty(cap, np.int64), np.empty(cap, np.int64)
+    shared = np.empty((N_SHARED, cap), np.float64)
+    shared_tot = np.zeros(2)
     geo = np.empty((N_GEO, cap), np.float64)
-    mags = np.empty((3, nb_max), np.float64)
     in_dense = np.zeros(cap, np.bool_)
-    order = np.zeros(cap, np.int64)
-    level = np.zeros(cap, np.int64)
+    order = np.zeros(2 * cap, np.int64)  # bucket of each listed source, then a bucket's members
     dense = np.empty((N_SRC, padded), np.float32)
     scratch = np.empty((6, max(tables.shape[1], far_points.shape[1])), c.dtype)
     scratch32 = np.empty((6, far_points.shape[1]), np.float32)
     p_ind = np.zeros((n, 2, nb_max), c.dtype)  # per emitter: induced moments of every body
-    body = np.empty((7, nb_max), c.dtype)  # x, y, alpha, m1x, m1y, m2x, m2y
+    body = np.empty((9, nb_max), c.dtype)  # x, y, alpha, m1x, m1y, m2x, m2y, t1x, t1y
     # sin and cos of every heading and pellet orientation, vectorised (libm's are scalar calls)
     angles = np.empty(n + pellet_xy.shape[1])
     sin_t, cos_t = np.empty_like(angles), np.empty_like(angles)
+    share = levels.shape[0] > 0 and flags[CULL] and c[G_SELF] == c[G_CONS]
     for b in range(b_count):
         img = image_table(width[b], height[b], img_idx, img_w, c)
         if flags[DO_AMP]:
@@ -451,6 +278,7 @@ def sense_batch_kernel(agent_xy, heading, emitting, pellet_xy, pellet_phi, pelle
             body[0, j], body[1, j] = 100.0, 100.0
             body[2:, j] = c[ZERO]
         nb = -(-nb // BLOCK) * BLOCK
+        n_src = nb * img.shape[0]
         induction = False
         if flags[DO_INDUCTION]:
             for e in range(n):
@@ -458,15 +286,41 @@ def sense_batch_kernel(agent_xy, heading, emitting, pellet_xy, pellet_phi, pelle
         if induction:
             induced_dipoles(agent_xy[b], heading[b], emitting[b], body[0, :nb], body[1, :nb], body[2, :nb], img, c,
                             p_ind)
+        # T1: every emitter's induced moment, which each agent weighs alike in shared mode
+        t1x, t1y = body[7, :nb], body[8, :nb]
+        t1x[:] = c[ZERO]
+        t1y[:] = c[ZERO]
+        s_max = 0.0  # the largest Mormyromast weight of any agent
+        if share and flags[DO_MORM] and induction:
+            for e in range(n):
+                t1x += p_ind[e, 0, :nb]
+                t1y += p_ind[e, 1, :nb]
+            for a in range(n):
+                s_max = max(s_max, abs(mormyromast_weights(a, emitting[b], c)[1]))
+        list_images(body[0, :nb], body[1, :nb], t1x, t1y, body[5, :nb], body[6, :nb], img, n, lst, own, owner)
+        src, src_own, n_list, n_shared = lst, own, n_src, 0
+        shared_tot[:] = 0.0
+        shared_mode = share and (flags[DO_MORM] or flags[DO_AMP])
+        if shared_mode:
+            n_shared, n_list, shared_tot[0], shared_tot[1] = share_far_sources(
+                n_src, agent_xy[b], lst, own, owner, s_max, c[TOL_MORM], c[TOL_AMP], c, level_lcq, level_e, geo,
+                in_dense, order, shared, rest, rest_own, rest_owner)
+            src, src_own = rest, rest_own
         for a in range(n if (flags[DO_MORM] or flags[DO_AMP]) else 0):
-            if flags[DO_MORM] and induction:
-                mormyromast_moments(a, emitting[b], p_ind, c, body[3, :nb], body[4, :nb])
-            else:
-                body[3, :nb] = c[ZERO]
-                body[4, :nb] = c[ZERO]
-            sense_agent(a, agent_xy[b], heading[b], emitting[b], body[0, :nb], body[1, :nb], body[3, :nb],
-                        body[4, :nb], body[5, :nb], body[6, :nb], img, c, c32, flags, tables, levels, level_lcq, level_e, far_offsets, far_points,
-                        interp_m, interp_a, mags, geo, in_dense, order, level, dense, exact, far, offsets, scratch, scratch32,
+            weight = mormyromast_weights(a, emitting[b], c)[1] if (flags[DO_MORM] and induction) else 0.0
+            if shared_mode:  # the agent's Mormyromast moments are weight x T1
+                copy_shared(agent_xy[b, a, 0], agent_xy[b, a, 1], weight, shared, n_shared, dense)
+                weighted_moments(a, n_list, weight, rest, rest_owner, geo)
+            else:  # the full list, with the agent's own moments of every body
+                if flags[DO_MORM] and induction:
+                    mormyromast_moments(a, emitting[b], p_ind, c, body[3, :nb], body[4, :nb])
+                else:
+                    body[3, :nb] = c[ZERO]
+                    body[4, :nb] = c[ZERO]
+                imaged_moments(img, body[3, :nb], body[4, :nb], geo)
+            sense_agent(a, agent_xy[b], heading[b], emitting[b], n_list, src, src_own, n_shared, shared_tot, img, c,
+                        c32, flags, tables, levels, level_lcq, level_e, far_offsets, far_points, interp_m, interp_a,
+                        geo, in_dense, order, dense, exact, far, offsets, scratch, scratch32,
                         out_m[b, a], out_a[b, a])
         if flags[DO_KNOLL]:
             knollenorgan_env(agent_xy[b], heading[b], emitting[b], cos_k, sin_k, c, flags, out_k[b])

@@ -1,0 +1,372 @@
+"""Source lists of the fast path (numba): every body image, culled and sorted by how it is evaluated.
+
+Each arena lists its body images once (:func:`list_images`). Seen from an
+agent, a source is culled (its bound is below ``tolerance x E_min``), served by
+a far-field level (its reading on the sensor circle is smooth enough to carry
+from a few points, see :mod:`efish.physics.sense_kernel`) or exact.
+
+Most sources are far from every agent. When every agent weighs the self and
+cons induced moments alike (g_self = g_cons, the default), an agent's
+Mormyromast moment of a pellet is the same vector times an agent weight, so
+those sources are tested once per arena, at the nearest agent with the largest
+weight, and shared (:func:`share_far_sources`): every agent evaluates them at
+the first level without staging them. Only the rest, about a fifth, is staged
+per agent (:func:`gather_sources`).
+
+Loops here are narrow on purpose: a loop over many arrays needs more runtime
+alias checks than LLVM allows and stays scalar (3-4x slower), and a per-source
+lookup through an index array (a gather) costs as much; so per-source
+quantities are laid out in rows and each pass touches few of them.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .kernels import _FASTMATH, FAR_MAX_LS, FAR_MAX_LX, M1X, M1Y, M2X, M2Y, R_SENS, SX, SY
+
+# Rows of a source list (float64), one column per body image; in the arena's full list
+# image i of body j is column i * bodies + j. Moments are image moments (mirrored,
+# times the wall weight). T1: the Mormyromast moment per unit of an agent's weight
+# (shared mode); M2: the Ampullary moment; A1, A2: their magnitudes.
+L_X, L_Y, L_T1X, L_T1Y, L_M2X, L_M2Y, L_A1, L_A2, N_LIST = range(9)
+# Rows of the per-agent staging array ``geo`` (float64), one column per listed source.
+G_P1X, G_P1Y, G_A1, G_M1X, G_M1Y, G_M2X, G_M2Y, G_LS, G_LX, G_KEEP, G_UNIT, G_D2, N_GEO = range(13)
+# Rows of the shared sources (float64): position, T1 and M2 moments.
+S_X, S_Y, S_T1X, S_T1Y, S_M2X, S_M2Y, N_SHARED = range(7)
+# Sources per SIMD block, measured best: float32 loops over 24 sources take longer than over 32
+# (a scalar remainder), float64 loops over sensors x sources pay per 8 sources.
+BLOCK = 16
+EXACT_BLOCK = 8
+MITCHELL_ERROR = 0.0861  # max of log2(1 + f) - f on [0, 1]: the bit-pattern log2 is at most this low
+NOBODY = -1  # ``own``/``owner`` of a source that is no agent's
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def image_rows(img, vx, vy, out_x, out_y, out_a):
+    """Image i of body j at column i * bodies + j: mirrored, weighted (vx, vy) and its magnitude."""
+    nb = vx.shape[0]
+    for i in range(img.shape[0]):
+        fx, fy, w = img[i, 1] * img[i, 4], img[i, 3] * img[i, 4], abs(img[i, 4])
+        ox, oy, oa = out_x[i * nb:(i + 1) * nb], out_y[i * nb:(i + 1) * nb], out_a[i * nb:(i + 1) * nb]
+        for j in range(nb):
+            x, y = np.float64(vx[j]), np.float64(vy[j])  # induced moments squared underflow float32
+            ox[j] = fx * x
+            oy[j] = fy * y
+            oa[j] = w * np.sqrt(x * x + y * y)
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def list_images(bx, by, t1x, t1y, m2x, m2y, img, n_agents, lst, own, owner):
+    """The arena's full source list: every body image, with ``own`` (the agent whose own body it is, identity
+    image only) and ``owner`` (the agent whose body it is, every image), NOBODY for pellets."""
+    nb = bx.shape[0]
+    for i in range(img.shape[0]):
+        ox, sx, oy, sy = img[i, 0], img[i, 1], img[i, 2], img[i, 3]
+        x, y = lst[L_X, i * nb:(i + 1) * nb], lst[L_Y, i * nb:(i + 1) * nb]
+        for j in range(nb):
+            x[j] = ox + sx * bx[j]
+            y[j] = oy + sy * by[j]
+        for j in range(nb):
+            owner[i * nb + j] = j if j < n_agents else NOBODY
+            own[i * nb + j] = j if (j < n_agents) & (i == 0) else NOBODY
+    image_rows(img, t1x, t1y, lst[L_T1X], lst[L_T1Y], lst[L_A1])
+    image_rows(img, m2x, m2y, lst[L_M2X], lst[L_M2Y], lst[L_A2])
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def distance2(ax, ay, x, y, d2):
+    """Squared distance of every listed source from (ax, ay)."""
+    for t in range(x.shape[0]):
+        d2[t] = (x[t] - ax) * (x[t] - ax) + (y[t] - ay) * (y[t] - ay)
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def nearest_distance2(axy, x, y, d2):
+    """Squared distance of every listed source from the nearest agent."""
+    d2[:] = np.inf
+    for a in range(axy.shape[0]):
+        ax, ay = axy[a, 0], axy[a, 1]
+        for t in range(x.shape[0]):
+            d2[t] = min(d2[t], (x[t] - ax) * (x[t] - ax) + (y[t] - ay) * (y[t] - ay))
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def source_bounds(a, d2, own, a1, a2, inv1, inv2, r, geo):
+    """Bound of a unit moment 2 / (D - r)^3 (``G_UNIT``), bound / threshold (``G_LS``) and D^2 (``G_LX``).
+
+    a1, a2: |moment| of both columns; inv1, inv2: 1 / their thresholds. Branch-free,
+    so it vectorises; ``G_LS`` and ``G_LX`` stay > 0 for their log2. Agent ``a``'s
+    own body (its identity image, ``own == a``) gets bound 0: its own induced moment
+    is 0 and its intrinsic dipole enters through its images only.
+    """
+    unit, ls, lx = geo[G_UNIT, :d2.shape[0]], geo[G_LS, :d2.shape[0]], geo[G_LX, :d2.shape[0]]
+    for t in range(d2.shape[0]):
+        gap = max(np.sqrt(d2[t]) - r, 1e-100)  # a source inside the sensor circle gets a huge bound
+        u = 2.0 / (gap * gap * gap) * (own[t] != a)
+        unit[t] = u
+        ls[t] = u * max(a1[t] * inv1, a2[t] * inv2) + 1e-300
+        lx[t] = d2[t] + 1e-300
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def cull_column(a, mag, mx, my, own, unit, thr, out_x, out_y):
+    """One column's moments, 0 where the bound |m| * unit is below ``thr``; returns the bound sum.
+
+    ``a``'s own body is dropped (see :func:`source_bounds`), also when nothing is culled (thr < 0).
+    """
+    total = 0.0  # bounds steer decisions only: float64 whatever the dtype
+    for t in range(unit.shape[0]):
+        b = mag[t] * unit[t]
+        total += b
+        keep = (mag[t] > 0) & (b >= thr) & (own[t] != a)
+        out_x[t] = mx[t] * keep
+        out_y[t] = my[t] * keep
+    return total
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def log2_upper(values, out):
+    """out >= log2(values) within 0.09, from the float bit pattern (Mitchell); vectorises, no libm call."""
+    bits = values.view(np.int64)
+    for k in range(values.shape[0]):
+        out[k] = bits[k] * 2.0 ** -52 - 1023.0 + MITCHELL_ERROR
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def dense_level_sources(n, geo, level_lcq, level_e, c, dense):
+    """dense[k] = 1 where source k is served by the first far level, else 0.
+
+    The bound of level l is C Q_l B x^(e_l); in log2 the condition is
+    log2(C Q_l) + ls + e_l lx <= 0, with upper bounds ``ls`` >= log2(bound /
+    threshold) and lx >= log2(r / D), written over ``geo`` rows G_LS and G_LX,
+    so the choice errs towards accuracy. A source is never interpolated when it
+    is closer than the far-field minimum, or so strong (bound / threshold >
+    2^FAR_MAX_LS) that float32, in which interpolated sources are evaluated,
+    would round off more than the threshold. Branch-free, so it vectorises.
+    """
+    ls, lx = geo[G_LS, :n], geo[G_LX, :n]
+    log2_upper(ls, ls)
+    log2_upper(lx, lx)
+    log2_r = math.log2(c[R_SENS])
+    lcq, e = level_lcq[0], level_e[0]
+    max_lx, max_ls = c[FAR_MAX_LX], c[FAR_MAX_LS]  # locals: LLVM reloads array elements after every store
+    for k in range(n):
+        lx[k] = log2_r - 0.5 * (lx[k] - MITCHELL_ERROR)
+        near = (lx[k] > max_lx) | (ls[k] > max_ls)
+        dense[k] = (lcq + ls[k] + e * lx[k] <= 0) & (near == 0)
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def source_buckets(n, geo, in_dense, level_lcq, level_e, c, bucket):
+    """bucket[k] of listed source k: -1 when culled or dense, else 0 (exact) or 1 + its far level.
+
+    The level is the lowest (fewest points) whose bound passes; a source too
+    close or too strong for float32 is exact (see :func:`dense_level_sources`).
+    One branch-free pass per level, so each vectorises.
+    """
+    ls, lx, keep, b = geo[G_LS, :n], geo[G_LX, :n], geo[G_KEEP, :n], bucket[:n]
+    max_lx, max_ls = c[FAR_MAX_LX], c[FAR_MAX_LS]  # locals: LLVM reloads array elements after every store
+    b[:] = 0
+    for lv in range(level_e.shape[0] - 1, 0, -1):  # highest first: the lowest passing level wins
+        lcq, e, value = level_lcq[lv], level_e[lv], lv + 1
+        for k in range(n):
+            b[k] = value if lcq + ls[k] + e * lx[k] <= 0 else b[k]
+    for k in range(n):
+        near = (lx[k] > max_lx) | (ls[k] > max_ls)
+        b[k] = -1 if (keep[k] == 0) | (in_dense[k] != 0) else (0 if near else b[k])
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def fill_bucket(bucket, lv, x, y, geo, ox, oy, members, out, first):
+    """Copy the sources of bucket ``lv`` to ``out`` from column ``first`` on, positions minus (ox, oy).
+
+    The members are listed first (branch-free), then copied: buckets hold a
+    few of the listed sources. Returns the column after the last member.
+    """
+    count = 0
+    for k in range(bucket.shape[0]):
+        members[count] = k
+        count += bucket[k] == lv
+    for t in range(count):
+        k, q = members[t], first + t
+        out[SX, q], out[SY, q] = x[k] - ox, y[k] - oy
+        out[M1X, q], out[M1Y, q] = geo[G_M1X, k], geo[G_M1Y, k]
+        out[M2X, q], out[M2Y, q] = geo[G_M2X, k], geo[G_M2Y, k]
+    return first + count
+
+
+@njit(cache=True, error_model="numpy")
+def pad_bucket(out, lo, hi, x):
+    """Inert sources (moment 0, at x + 1 m) in columns lo:hi of ``out``."""
+    for q in range(lo, hi):
+        out[SX, q], out[SY, q] = x + 1.0, 0.0
+        out[M1X, q] = out[M1Y, q] = out[M2X, q] = out[M2Y, q] = 0.0
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def masked_copy(mx, my, mask, out_x, out_y):
+    """out = m where mask, else 0, rounded to the type of ``out``."""
+    for k in range(mask.shape[0]):
+        out_x[k] = mx[k] * mask[k]
+        out_y[k] = my[k] * mask[k]
+
+
+@njit(cache=True, error_model="numpy")
+def copy_columns(src, rows, index, count, dst, first):
+    """dst[r, first + t] = src[r, index[t]] for the given rows and t < count."""
+    for r in rows:
+        s, d = src[r], dst[r, first:first + count]
+        for t in range(count):
+            d[t] = s[index[t]]
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def share_far_sources(n, axy, lst, own, owner, s_max, thr1, thr2, c, level_lcq, level_e, geo, flag, order,
+                      shared, rest, rest_own, rest_owner):
+    """Split the first ``n`` listed sources into those every agent serves by the first far level and the rest.
+
+    The test runs once per arena at the distance of the nearest agent, with
+    the Mormyromast moment T1 times the largest agent weight ``s_max``, so a
+    shared source passes the per-agent test of every agent. Agents' bodies are
+    never shared (each agent drops its own). Shared sources go to ``shared``
+    (rows ``S_*``), the rest to ``rest`` (rows ``L_*``, with ``rest_own`` and
+    ``rest_owner``). Returns both counts and the bound sums of the shared
+    sources in both columns (for the exact-zero test of each agent).
+    """
+    own, owner = own[:n], owner[:n]
+    d2 = geo[G_D2, :n]
+    nearest_distance2(axy, lst[L_X, :n], lst[L_Y, :n], d2)
+    inv1 = s_max / thr1
+    source_bounds(-2, d2, own, lst[L_A1, :n], lst[L_A2, :n], inv1, 1.0 / thr2, c[R_SENS], geo)
+    dense_level_sources(n, geo, level_lcq, level_e, c, flag)
+    n_shared = 0
+    total1 = total2 = 0.0
+    unit, a1, a2 = geo[G_UNIT, :n], lst[L_A1, :n], lst[L_A2, :n]
+    for k in range(n):  # branch-free compaction: shared first in ``order``
+        take = flag[k] & (owner[k] == NOBODY)
+        order[n_shared] = k
+        n_shared += take
+        total1 += a1[k] * unit[k] * take
+        total2 += a2[k] * unit[k] * take
+    n_rest = 0
+    rest_index = order[n_shared:n]
+    for k in range(n):
+        rest_index[n_rest] = k
+        n_rest += (flag[k] == 0) | (owner[k] != NOBODY)
+    copy_columns(lst, (L_X, L_Y, L_T1X, L_T1Y, L_M2X, L_M2Y), order, n_shared, shared, 0)
+    copy_columns(lst, (L_X, L_Y, L_T1X, L_T1Y, L_M2X, L_M2Y, L_A1, L_A2), rest_index, n_rest, rest, 0)
+    for t in range(n_rest):
+        rest_own[t], rest_owner[t] = own[rest_index[t]], owner[rest_index[t]]
+    return n_shared, n_rest, total1 * s_max, total2
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def copy_shared(ax, ay, weight, shared, n_shared, dense):
+    """The shared sources as agent (ax, ay) evaluates them: float32, relative to it, Mormyromast moment x ``weight``."""
+    x, y, t1x, t1y = shared[S_X, :n_shared], shared[S_Y, :n_shared], shared[S_T1X, :n_shared], shared[S_T1Y, :n_shared]
+    ox, oy, o1x, o1y = dense[SX, :n_shared], dense[SY, :n_shared], dense[M1X, :n_shared], dense[M1Y, :n_shared]
+    for q in range(n_shared):
+        ox[q] = x[q] - ax
+        oy[q] = y[q] - ay
+        o1x[q] = weight * t1x[q]
+        o1y[q] = weight * t1y[q]
+    m2x, m2y, o2x, o2y = shared[S_M2X, :n_shared], shared[S_M2Y, :n_shared], dense[M2X, :n_shared], dense[M2Y, :n_shared]
+    for q in range(n_shared):
+        o2x[q] = m2x[q]
+        o2y[q] = m2y[q]
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def weighted_moments(a, n, weight, lst, owner, geo):
+    """Agent ``a``'s Mormyromast moments of listed sources in shared mode: weight x T1, 0 for its own body."""
+    t1x, t1y, a1, own_body = lst[L_T1X, :n], lst[L_T1Y, :n], lst[L_A1, :n], owner[:n]
+    p1x, p1y, p1a = geo[G_P1X, :n], geo[G_P1Y, :n], geo[G_A1, :n]
+    for t in range(n):
+        w = weight * (own_body[t] != a)
+        p1x[t] = w * t1x[t]
+        p1y[t] = w * t1y[t]
+    for t in range(n):
+        p1a[t] = abs(weight) * a1[t] * (own_body[t] != a)
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def imaged_moments(img, m1x, m1y, geo):
+    """An agent's Mormyromast moments of every body image, from its per-body moments (full list only)."""
+    image_rows(img, m1x, m1y, geo[G_P1X], geo[G_P1Y], geo[G_A1])
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def gather_sources(a, n, ax, ay, lst, own, thr1, thr2, c, level_lcq, level_e, n_shared, geo, in_dense, order, dense,
+                   exact, far, offsets):
+    """The first ``n`` listed sources whose bound at agent ``a`` reaches a threshold, bucketed by level.
+
+    ``geo`` rows G_P1X, G_P1Y, G_A1 hold the agent's Mormyromast moments of
+    the listed sources (:func:`weighted_moments` or :func:`imaged_moments`);
+    ``dense[:, :n_shared]`` already holds the shared sources. Column 1
+    (Mormyromast) and column 2 (Ampullary) are culled separately; a culled
+    column is stored as 0. Listed sources of the first far level go to
+    ``dense`` after the shared ones (float32, positions relative to the agent,
+    where float32 is precise), every source in its own column with the others'
+    moments zeroed: one long loop over sources evaluates them. Only the rest, a
+    few tens, are bucketed: bucket l holds sources ``offsets[l]:offsets[l + 1]``,
+    the exact ones (bucket 0) in ``exact`` in the working dtype, those of the
+    higher levels in the same columns of ``far`` in float32 (bucket 1, the
+    dense level, stays empty). Every bucket is padded with inert sources
+    (moment 0, 1 m away) to a multiple of ``EXACT_BLOCK`` (bucket 0) or
+    ``BLOCK``, so its loops run without a scalar remainder. Returns the number
+    of dense columns (0 without far levels) and the bound sums of both columns.
+    """
+    own = own[:n]
+    x, y = lst[L_X, :n], lst[L_Y, :n]
+    d2 = geo[G_D2, :n]
+    distance2(ax, ay, x, y, d2)
+    inv1 = 1.0 / thr1 if thr1 > 0 else 0.0
+    inv2 = 1.0 / thr2 if thr2 > 0 else 0.0
+    source_bounds(a, d2, own, geo[G_A1, :n], lst[L_A2, :n], inv1, inv2, c[R_SENS], geo)
+    unit = geo[G_UNIT, :n]
+    total1 = cull_column(a, geo[G_A1, :n], geo[G_P1X, :n], geo[G_P1Y, :n], own, unit, thr1, geo[G_M1X, :n],
+                         geo[G_M1Y, :n])
+    total2 = cull_column(a, lst[L_A2, :n], lst[L_M2X, :n], lst[L_M2Y, :n], own, unit, thr2, geo[G_M2X, :n],
+                         geo[G_M2Y, :n])
+    for k in range(n):
+        geo[G_KEEP, k] = (geo[G_M1X, k] != 0) | (geo[G_M1Y, k] != 0) | (geo[G_M2X, k] != 0) | (geo[G_M2Y, k] != 0)
+    n_levels = level_e.shape[0]
+    if n_levels > 0:
+        dense_level_sources(n, geo, level_lcq, level_e, c, in_dense)
+    else:
+        in_dense[:n] = False
+    m = n_shared + n
+    n_dense = -(-m // BLOCK) * BLOCK if n_levels > 0 else 0
+    # rows sliced to start at the first listed source: a loop index from 0 keeps the copies vectorised
+    ox, oy = dense[SX, n_shared:m], dense[SY, n_shared:m]
+    for k in range(n):
+        ox[k], oy[k] = x[k] - ax, y[k] - ay
+    masked_copy(geo[G_M1X, :n], geo[G_M1Y, :n], in_dense[:n], dense[M1X, n_shared:m], dense[M1Y, n_shared:m])
+    masked_copy(geo[G_M2X, :n], geo[G_M2Y, :n], in_dense[:n], dense[M2X, n_shared:m], dense[M2Y, n_shared:m])
+    for k in range(m, n_dense):
+        dense[SX, k], dense[SY, k] = 1.0, 0.0
+        dense[M1X, k] = dense[M1Y, k] = dense[M2X, k] = dense[M2Y, k] = 0.0
+    # the others, a few tens, by bucket; each bucket padded to whole blocks
+    bucket, members = order[:n], order[n:2 * n]
+    if n_levels > 0:
+        source_buckets(n, geo, in_dense, level_lcq, level_e, c, bucket)
+    else:
+        for k in range(n):
+            bucket[k] = 0 if geo[G_KEEP, k] != 0 else -1
+    offsets[:] = 0
+    for k in range(n):
+        offsets[bucket[k] + 1] += bucket[k] >= 0
+    for lv in range(offsets.shape[0] - 1):
+        block = EXACT_BLOCK if lv == 0 else BLOCK
+        offsets[lv + 1] = offsets[lv] + -(-offsets[lv + 1] // block) * block
+    end = fill_bucket(bucket, 0, x, y, geo, 0.0, 0.0, members, exact, 0)  # exact: absolute positions, working dtype
+    pad_bucket(exact, end, offsets[1], ax)
+    for lv in range(2, offsets.shape[0] - 1):  # bucket 1, the dense level, stays empty
+        if offsets[lv + 1] > offsets[lv]:
+            end = fill_bucket(bucket, lv, x, y, geo, ax, ay, members, far, offsets[lv])
+            pad_bucket(far, end, offsets[lv + 1], 0.0)
+    return n_dense, total1, total2
