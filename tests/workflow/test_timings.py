@@ -30,3 +30,16 @@ def test_jobs_are_grouped_by_folder_and_summed(tmp_path):
 def test_no_benchmarks_is_one_clear_error(tmp_path):
     with pytest.raises(ValueError, match="no Snakemake benchmark files"):
         pipeline_timings(tmp_path)
+
+
+def test_interleaved_timing_alternates_and_keeps_each_best(monkeypatch):
+    """Runs go a, b, a, b (not a, a, b, b), and each function gets the best of its own runs."""
+    from efish.bench import timing
+
+    clock = iter([0.0, 5.0, 5.0, 6.0, 6.0, 8.0, 8.0, 8.5])  # a: 5 then 2 s, b: 1 then 0.5 s
+    monkeypatch.setattr(timing.time, "perf_counter", lambda: next(clock))
+    calls = []
+    best = timing.best_times_interleaved([lambda: calls.append("a"), lambda: calls.append("b")], rounds=2,
+                                         warmup=False)
+    assert calls == ["a", "b", "a", "b"]
+    assert best == [2.0, 0.5]

@@ -8,7 +8,7 @@ import numpy as np
 
 from ..config.schema import EfishConfig
 from ..env.vec_env import VecEnv
-from .timing import best_time
+from .timing import best_times_interleaved
 
 SCENES = {"patchy70": "4-agent patchy 70x70", "onepatch": "2-agent one-patch 150x150"}
 
@@ -17,9 +17,8 @@ def _random_actions(rng: np.random.Generator, b: int, n: int) -> np.ndarray:
     return np.concatenate([rng.normal(size=(b, n, 2)), rng.integers(0, 2, (b, n, 2))], axis=-1)
 
 
-def time_env(cfg: EfishConfig, num_envs: int, steps: int, seed: int, reference: bool = False,
-             repeats: int = 3) -> float:
-    """Agent-steps per second of ``steps`` random-action steps of ``num_envs`` arenas (one thread)."""
+def env_runner(cfg: EfishConfig, num_envs: int, steps: int, seed: int, reference: bool = False):
+    """A function stepping ``num_envs`` arenas ``steps`` times with random actions, and its agent-steps per call."""
     env = VecEnv(cfg, num_envs=num_envs, seed=seed, reference=reference)  # reference: same env, oracle physics
     env.reset()
     rng = np.random.default_rng(seed)
@@ -28,22 +27,27 @@ def time_env(cfg: EfishConfig, num_envs: int, steps: int, seed: int, reference: 
     def run():
         for a in acts:
             env.step(a)
-    seconds = best_time(run, repeats=1 if reference else repeats)
-    return num_envs * env.n * steps / seconds
+    return run, num_envs * env.n * steps
 
 
 def bench_env(cfg: EfishConfig, num_envs: int = 16, steps: int = 100, reference_steps: int = 3) -> list[dict]:
-    """Throughput rows for the benchmark scenes: fast path, reference, ratio."""
+    """Throughput rows for the benchmark scenes: fast path, reference, ratio (one thread).
+
+    Fast and reference runs alternate (``bench.reference_rounds`` rounds, best of
+    each), so the ratio is not skewed by the machine's speed drifting between them.
+    """
     rows = []
     for arena, label in SCENES.items():
         from ..config import compose
 
         scene = compose([f"arena={arena}", f"env.n_agents={4 if arena == 'patchy70' else 2}"])
         scene = dataclasses.replace(scene, env=dataclasses.replace(scene.env, episode_steps=10**9))
-        fast = time_env(scene, num_envs, steps, seed=cfg.bench.seed, repeats=cfg.bench.repeats)
-        ref = time_env(scene, num_envs, reference_steps, seed=cfg.bench.seed, reference=True)
-        rows.append({"scene": label, "num_envs": num_envs, "fast_agent_steps_per_s": fast,
-                     "reference_agent_steps_per_s": ref, "speedup": fast / ref})
+        fast, fast_n = env_runner(scene, num_envs, steps, cfg.bench.seed)
+        ref, ref_n = env_runner(scene, num_envs, reference_steps, cfg.bench.seed, reference=True)
+        fast()  # compiles
+        fast_s, ref_s = best_times_interleaved([fast, ref], cfg.bench.reference_rounds, warmup=False)
+        rows.append({"scene": label, "num_envs": num_envs, "fast_agent_steps_per_s": fast_n / fast_s,
+                     "reference_agent_steps_per_s": ref_n / ref_s, "speedup": (fast_n / fast_s) / (ref_n / ref_s)})
     return rows
 
 

@@ -16,3 +16,21 @@ def best_time(fn: Callable[[], object], repeats: int, warmup: bool = True) -> fl
         fn()
         best = min(best, time.perf_counter() - t0)
     return best
+
+
+def best_times_interleaved(fns: list[Callable[[], object]], rounds: int, warmup: bool = True) -> list[float]:
+    """Fastest call of each function in seconds, calling them in turn for ``rounds`` rounds.
+
+    For ratios between runs (fast path vs reference): this machine's speed drifts
+    from minute to minute, and interleaving exposes both to the same drift.
+    """
+    if warmup:
+        for fn in fns:
+            fn()
+    best = [float("inf")] * len(fns)
+    for _ in range(rounds):
+        for i, fn in enumerate(fns):
+            t0 = time.perf_counter()
+            fn()
+            best[i] = min(best[i], time.perf_counter() - t0)
+    return best

@@ -254,6 +254,8 @@ class BenchConfig:
     scenes: int = param(64, "benchmark snapshots (4-agent 70x70 patchy)", lo=1)
     repeats: int = param(7, "timing repeats; the fastest is reported (this VM is noisy)", lo=1)
     reference_scenes: int = param(8, "snapshots timed with the brute-force reference", lo=1)
+    reference_rounds: int = param(3, "rounds of fast and reference runs in turn, for their ratio (best of each)",
+                                  lo=1)
     tolerances: list = param([0.0, 1e-11, 1e-9, 1e-8, 1e-7, 1e-6, 1e-5, 1e-3, 1e-1, 1.0], "tolerances swept")
     image_orders: list = param([0, 1, 2, 3], "wall image orders swept")
     dtypes: list = param(["float64", "float32"], "kernel dtypes swept")
