@@ -25,14 +25,12 @@ its time in the scalar remainder.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numba import njit
 
 from .kernels import (
     _FASTMATH, ALPHA_AGENT, ALPHA_PELLET, CULL, DO_AMP, DO_INDUCTION, DO_KNOLL, DO_MORM, DO_PELLETS,
-    DO_WALLDIST, FAR_MAX_LS, FAR_MAX_LX, G_CONS, G_SELF, HALF_SEP, K, K_CONS, KNOLL_ZERO, M1X, M1Y, M2X, M2Y, N_SRC, ONE,
+    DO_WALLDIST, G_CONS, G_SELF, HALF_SEP, K, K_CONS, KNOLL_ZERO, M1X, M1Y, M2X, M2Y, N_SRC, ONE,
     P_AGENT, P_PELLET, Q, R_SENS, SOFT2, SX, SY, THREE, TOL_AMP, TOL_MORM, ZERO, ZERO_AMP, ZERO_MORM,
     add_monopole, far_readings, image_table, induced_dipoles, place_on_circle, place_sensors,
 )
