@@ -47,16 +47,26 @@ NOBODY = -1  # ``own``/``owner`` of a source that is no agent's
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
 def image_rows(img, vx, vy, out_x, out_y, out_a):
-    """Image i of body j at column i * bodies + j: mirrored, weighted (vx, vy) and its magnitude."""
+    """Image i of body j at column i * bodies + j: mirrored, weighted (vx, vy) and its magnitude.
+
+    Image 0 is the identity (weight 1), so its magnitudes are the bodies' own and
+    every other image's are a weight times them: one square root per body.
+    """
     nb = vx.shape[0]
+    body_a = out_a[:nb]
+    for j in range(nb):
+        x, y = np.float64(vx[j]), np.float64(vy[j])  # induced moments squared underflow float32
+        body_a[j] = np.sqrt(x * x + y * y)
     for i in range(img.shape[0]):
         fx, fy, w = img[i, 1] * img[i, 4], img[i, 3] * img[i, 4], abs(img[i, 4])
-        ox, oy, oa = out_x[i * nb:(i + 1) * nb], out_y[i * nb:(i + 1) * nb], out_a[i * nb:(i + 1) * nb]
+        ox, oy = out_x[i * nb:(i + 1) * nb], out_y[i * nb:(i + 1) * nb]
         for j in range(nb):
-            x, y = np.float64(vx[j]), np.float64(vy[j])  # induced moments squared underflow float32
-            ox[j] = fx * x
-            oy[j] = fy * y
-            oa[j] = w * np.sqrt(x * x + y * y)
+            ox[j] = fx * np.float64(vx[j])
+            oy[j] = fy * np.float64(vy[j])
+        if i > 0:
+            oa = out_a[i * nb:(i + 1) * nb]
+            for j in range(nb):
+                oa[j] = w * body_a[j]
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
