@@ -35,8 +35,8 @@ from .kernels import (
     add_monopole, far_readings, image_table, induced_dipoles, place_on_circle, place_sensors,
 )
 from .sources import (
-    BLOCK, N_GEO, N_LIST, N_SHARED, copy_shared, gather_sources, imaged_moments, list_images,
-    share_far_sources, weighted_moments,
+    BLOCK, L_A1, L_T1X, L_T1Y, N_GEO, N_LIST, N_SHARED, copy_shared, gather_sources, image_rows, imaged_moments,
+    list_images, share_far_sources, weighted_moments,
 )
 from .trig import sincos
 
@@ -295,11 +295,12 @@ def sense_batch_kernel(agent_xy, heading, emitting, pellet_xy, pellet_phi, pelle
                 t1y += p_ind[e, 1, :nb]
             for a in range(n):
                 s_max = max(s_max, abs(mormyromast_weights(a, emitting[b], c)[1]))
-        list_images(body[0, :nb], body[1, :nb], t1x, t1y, body[5, :nb], body[6, :nb], img, n, lst, own, owner)
+        list_images(body[0, :nb], body[1, :nb], body[5, :nb], body[6, :nb], img, n, lst, own, owner)
         src, src_own, n_list, n_shared = lst, own, n_src, 0
         shared_tot[:] = 0.0
         shared_mode = share and (flags[DO_MORM] or flags[DO_AMP])
         if shared_mode:
+            image_rows(img, t1x, t1y, lst[L_T1X], lst[L_T1Y], lst[L_A1])
             n_shared, n_list, shared_tot[0], shared_tot[1] = share_far_sources(
                 n_src, agent_xy[b], lst, own, owner, s_max, c[TOL_MORM], c[TOL_AMP], c, level_lcq, level_e, geo,
                 in_dense, order, shared, rest, rest_own, rest_owner)

@@ -70,9 +70,10 @@ def image_rows(img, vx, vy, out_x, out_y, out_a):
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def list_images(bx, by, t1x, t1y, m2x, m2y, img, n_agents, lst, own, owner):
-    """The arena's full source list: every body image, with ``own`` (the agent whose own body it is, identity
-    image only) and ``owner`` (the agent whose body it is, every image), NOBODY for pellets."""
+def list_images(bx, by, m2x, m2y, img, n_agents, lst, own, owner):
+    """The arena's full source list: every body image with its Ampullary moment, ``own`` (the agent whose own
+    body it is, identity image only) and ``owner`` (the agent whose body it is, every image), NOBODY for pellets.
+    The T1 rows are filled by :func:`image_rows` in shared mode only."""
     nb = bx.shape[0]
     for i in range(img.shape[0]):
         ox, sx, oy, sy = img[i, 0], img[i, 1], img[i, 2], img[i, 3]
@@ -83,7 +84,6 @@ def list_images(bx, by, t1x, t1y, m2x, m2y, img, n_agents, lst, own, owner):
         for j in range(nb):
             owner[i * nb + j] = j if j < n_agents else NOBODY
             own[i * nb + j] = j if (j < n_agents) & (i == 0) else NOBODY
-    image_rows(img, t1x, t1y, lst[L_T1X], lst[L_T1Y], lst[L_A1])
     image_rows(img, m2x, m2y, lst[L_M2X], lst[L_M2Y], lst[L_A2])
 
 
