@@ -13,7 +13,7 @@ import pytest
 
 from efish import Snapshot
 from efish.config import compose
-from efish.physics import build_plan
+from efish.physics import Scene, build_plan
 
 RECEPTORS = ("mormyromast", "ampullary", "knollenorgan", "knollen_size")
 
@@ -58,7 +58,7 @@ def random_snapshot(rng: np.random.Generator, n_agents: int, n_pellets: int, wid
 
 def plan_for(cfg, snapshot: Snapshot, **kw):
     """The plan ``efish.sense`` would build for this snapshot."""
-    return build_plan(cfg, n_pellets=snapshot.n_pellets, any_emitter=bool(snapshot.agent_emitting.any()), **kw)
+    return build_plan(cfg, Scene.of_batch(snapshot.as_batch()), **kw)
 
 
 def assert_valid_readings(r: dict, n_agents: int) -> None:

@@ -1,17 +1,33 @@
-"""efish: MARL-trained weakly electric fish collectives, reproduced."""
+"""efish: MARL-trained weakly electric fish collectives, reproduced.
 
-from importlib.metadata import PackageNotFoundError, version
+The top-level names load lazily: ``import efish`` (and ``import efish.figures``
+or ``efish.analysis``) loads neither numba nor torch; ``efish.sense`` compiles
+the physics kernels on first use.
+"""
 
-try:
-    __version__ = version("efish")
-except PackageNotFoundError:  # running from a source tree without installation
-    __version__ = "0+unknown"
+from __future__ import annotations
 
-from . import _numba_cache  # noqa: E402
+from importlib import import_module
+from typing import Any
 
-_numba_cache.configure()  # before any kernel is defined: see _numba_cache
+from ._version import __version__
 
-from .physics.snapshot import Snapshot, SnapshotBatch  # noqa: E402
-from .sensing import sense, sense_batch  # noqa: E402
+# name -> module that defines it
+_LAZY = {
+    "Snapshot": "efish.physics.snapshot",
+    "SnapshotBatch": "efish.physics.snapshot",
+    "sense": "efish.sensors.sense",
+    "sense_batch": "efish.sensors.sense",
+}
 
 __all__ = ["Snapshot", "SnapshotBatch", "__version__", "sense", "sense_batch"]
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        return getattr(import_module(_LAZY[name]), name)
+    raise AttributeError(f"module 'efish' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(__all__)

@@ -236,9 +236,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         elif args.command == "figure":
             _figure(args, cfg, started)
         elif args.command == "plan":
+            from .env.vec_env import scene_of
             from .physics.plan import build_plan
 
-            print(build_plan(cfg).explain())
+            print(build_plan(cfg, scene_of(cfg)).explain())
         elif args.bench == "physics":
             _bench_physics(args, cfg, started)
         elif args.bench == "train":

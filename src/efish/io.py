@@ -50,7 +50,7 @@ def _git_commit() -> str | None:
 
 def provenance(started: datetime, extra: dict | None = None) -> dict:
     """efish version, git commit, package versions, command line, start and end time."""
-    from . import __version__
+    from ._version import __version__
 
     packages = {}
     for name in PROVENANCE_PACKAGES:

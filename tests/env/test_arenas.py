@@ -11,7 +11,13 @@ from scipy import stats
 
 from efish.config import compose
 from efish.env.arenas import (
-    drift_orientations, npatch_centres, patch_count, regrow_onepatch, sample_arena, sample_pellets, spawn_agents,
+    drift_orientations,
+    npatch_centres,
+    patch_count,
+    regrow_onepatch,
+    sample_arena,
+    sample_pellets,
+    spawn_agents,
 )
 
 RESETS = 400
@@ -136,7 +142,7 @@ def test_orientation_drift_has_the_configured_spread():
 def test_spawned_agents_keep_the_margin_and_never_overlap():
     rng = np.random.default_rng(6)
     for _ in range(100):
-        xy = spawn_agents(4, 10.0, 10.0, 1.0, rng)
+        xy = spawn_agents(4, 10.0, 10.0, 1.0, 1.0, rng)
         assert np.all((xy >= 1) & (xy <= 9))
         d = np.linalg.norm(xy[:, None] - xy[None], axis=-1) + np.eye(4) * 99
         assert d.min() >= 2.0
@@ -144,7 +150,7 @@ def test_spawned_agents_keep_the_margin_and_never_overlap():
 
 def test_spawning_too_many_agents_fails_with_a_clear_error():
     with pytest.raises(ValueError, match="could not place"):
-        spawn_agents(50, 5.0, 5.0, 1.0, np.random.default_rng(0), max_tries=2000)
+        spawn_agents(50, 5.0, 5.0, 1.0, 1.0, np.random.default_rng(0), max_tries=2000)
 
 
 def test_homing_training_arenas_have_no_food_and_span_75_to_150_cm():

@@ -13,7 +13,7 @@ from efish.env import VecEnv
 from efish.env.arenas import _wrap_2pi, drift_orientations, points_in_disc
 from efish.env.dynamics import record_motion
 from efish.env.observe import TAIL_SIZES, tail_kernel
-from efish.env.rewards import FORAGING_PARTS, foraging_rewards
+from efish.env.tasks.foraging import FORAGING_PARTS, foraging_rewards
 
 
 def assert_bits(got: np.ndarray, want: np.ndarray) -> None:

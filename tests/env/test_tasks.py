@@ -20,7 +20,7 @@ def test_bot_stays_within_its_bound_and_emits_at_its_rate():
     v_max = env.v_max()[:, 0].max()
     for _ in range(steps):
         _, _, _, _, info = env.step(actions(env, move=BIG, eod=1, bite=1))
-        d = np.linalg.norm(env.xy[:, 0] - 75.0, axis=-1)
+        d = np.linalg.norm(env.state.xy[:, 0] - 75.0, axis=-1)
         assert d.max() <= 8.5 + v_max
         assert not info["bit"][:, 0].any() and not info["ate"][:, 0].any()
         emitted += int(info["eod"][:, 0].sum())

@@ -23,9 +23,9 @@ def actions(env, move=-BIG, turn=0.0, eod=0, bite=0):
 
 
 def place_pellets(env, xy):
-    env.alive[:] = False
-    env.pellet_xy[0, : len(xy)] = xy
-    env.alive[0, : len(xy)] = True
+    env.state.alive[:] = False
+    env.state.pellet_xy[0, : len(xy)] = xy
+    env.state.alive[0, : len(xy)] = True
 
 
 @pytest.mark.parametrize("size", [0.0, 0.4, 1.0])
@@ -36,8 +36,8 @@ def test_speed_and_turn_bounds_scale_with_size(size):
     env.step(actions(env, move=BIG, turn=BIG))
     w_max = 3.6 * 4 * (1 + size) / 83
     v_max = 0.35 * 2 * (1 + size) * 100 / 83
-    assert env.heading[0, 0] == pytest.approx(w_max, rel=1e-12)
-    np.testing.assert_allclose(env.xy[0, 0], [35 + v_max * np.cos(w_max), 35 + v_max * np.sin(w_max)], rtol=1e-12)
+    assert env.state.heading[0, 0] == pytest.approx(w_max, rel=1e-12)
+    np.testing.assert_allclose(env.state.xy[0, 0], [35 + v_max * np.cos(w_max), 35 + v_max * np.sin(w_max)], rtol=1e-12)
     assert v_max == pytest.approx(0.8434 * (1 + size), rel=1e-4)
 
 
@@ -49,9 +49,9 @@ def test_agents_never_overlap_nor_leave_a_small_arena():
     for _ in range(300):
         a = np.concatenate([rng.normal(0, 3, (4, 4, 2)), rng.integers(0, 2, (4, 4, 2))], axis=-1)
         env.step(a)
-        d = np.linalg.norm(env.xy[:, :, None] - env.xy[:, None], axis=-1) + 99 * np.eye(4)
+        d = np.linalg.norm(env.state.xy[:, :, None] - env.state.xy[:, None], axis=-1) + 99 * np.eye(4)
         assert d.min() >= 2.0 - 1e-12
-        assert env.xy.min() >= 1.0 and env.xy.max() <= 11.0
+        assert env.state.xy.min() >= 1.0 and env.state.xy.max() <= 11.0
 
 
 def test_an_agent_eats_exactly_the_pellet_in_its_cone_then_freezes_for_three_steps():
@@ -59,13 +59,13 @@ def test_an_agent_eats_exactly_the_pellet_in_its_cone_then_freezes_for_three_ste
     env.reset()
     place_pellets(env, [[11.5, 10.0], [10.0, 11.5], [12.5, 10.0]])  # ahead, beside (90 deg), ahead but 2.5 cm
     _, r, _, _, info = env.step(actions(env, move=-BIG))
-    assert info["ate"][0, 0] and env.alive[0].tolist()[:3] == [False, True, True]
+    assert info["ate"][0, 0] and env.state.alive[0].tolist()[:3] == [False, True, True]
     assert info["reward_parts"]["food"][0, 0] == 10.0
     moved = []
     for _ in range(5):  # frozen on the 3 steps after eating, free on the 4th
-        before = env.xy.copy()
+        before = env.state.xy.copy()
         env.step(actions(env, move=BIG))
-        moved.append(bool(np.any(env.xy != before)))
+        moved.append(bool(np.any(env.state.xy != before)))
     assert moved == [False, False, False, True, True]
 
 
@@ -98,12 +98,12 @@ def test_shaping_sums_to_the_approach_over_the_perimeter():
     env = make("env.n_agents=1", "arena=uniform70", "env.starts=[[10,35,0.0]]", "env.sizes=[0.0]")
     env.reset()
     place_pellets(env, [[60.0, 35.0]])
-    env.d_food[:] = 50.0
+    env.state.goal_dist[:] = 50.0
     total = 0.0
     for _ in range(20):
         _, r, _, _, info = env.step(actions(env, move=BIG))
         total += info["reward_parts"]["shaping"][0, 0]
-    d_end = 60.0 - env.xy[0, 0, 0]
+    d_end = 60.0 - env.state.xy[0, 0, 0]
     assert total == pytest.approx((50.0 - d_end) / 280.0, rel=1e-9)
 
 
@@ -140,11 +140,11 @@ def test_an_ablated_receptor_block_is_all_zeros(receptor, block):
 def test_frozen_agent_never_moves():
     env = make("env.frozen=[1]", "arena=uniform70")
     env.reset()
-    start = env.xy[0, 1].copy(), env.heading[0, 1]
+    start = env.state.xy[0, 1].copy(), env.state.heading[0, 1]
     for _ in range(10):
         env.step(actions(env, move=BIG, turn=BIG))
-    np.testing.assert_array_equal(env.xy[0, 1], start[0])
-    assert env.heading[0, 1] == start[1]
+    np.testing.assert_array_equal(env.state.xy[0, 1], start[0])
+    assert env.state.heading[0, 1] == start[1]
 
 
 def test_same_seed_same_bits_and_different_seeds_differ():
@@ -167,7 +167,7 @@ def test_truncation_resets_and_keeps_the_final_observation():
     for k in range(3):
         obs, _, term, trunc, info = env.step(actions(env))
     assert trunc.all() and not term.any() and "final_obs" in info
-    assert (env.t == 0).all()
+    assert (env.state.t == 0).all()
 
 
 @pytest.mark.parametrize("override, key", [

@@ -137,7 +137,7 @@ def test_detection_fades_monotonically_with_distance(cfg):
 
 
 def test_front_sensors_read_prey_ahead_the_strongest(cfg):
-    from efish.sensors import mormyromast_angles
+    from efish.physics import mormyromast_angles
     r = sense(pellet_ahead(3.0, 0.0, True), cfg)
     m = np.abs(observer_reads(r, "mormyromast"))
     angles = np.degrees(mormyromast_angles(cfg.sensors.mormyromast))

@@ -8,9 +8,9 @@ import pytest
 from efish.config import compose
 from efish.config.schema import ConfigError, MormyromastConfig
 from efish.physics import build_plan
+from efish.physics.far_field import trig_interpolation_matrix
 from efish.physics.fields import coulomb_constant, dipole_field
-from efish.physics.plan import trig_interpolation_matrix
-from efish.sensors.layout import even_angles, mormyromast_angles
+from efish.physics.geometry import even_angles, mormyromast_angles
 
 
 @pytest.mark.parametrize("q", [3, 5, 9, 21])

@@ -14,7 +14,7 @@ import pytest
 
 from efish.physics.fast import fast_raw
 from efish.physics.reference import reference_raw
-from efish.sensing import normalise
+from efish.sensors.sense import normalise
 
 from ..conftest import cfg_with, plan_for, random_snapshot
 

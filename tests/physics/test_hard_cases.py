@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 from efish import Snapshot, sense
 from efish.physics.fast import fast_raw
 from efish.physics.reference import reference_raw
-from efish.sensing import normalise
+from efish.sensors.sense import normalise
 
 from ..conftest import RECEPTORS, assert_valid_readings, cfg_with, plan_for, random_snapshot
 

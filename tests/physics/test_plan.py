@@ -8,7 +8,9 @@ import numpy as np
 import pytest
 
 from efish import Snapshot, sense
-from efish.physics import build_plan
+from efish.env.vec_env import scene_of
+from efish.physics import Scene, build_plan
+from efish.sensors.sense import sense_batch
 
 from ..conftest import RECEPTORS, cfg_with, random_snapshot
 
@@ -40,35 +42,41 @@ def test_busy_scene_reads_something_everywhere(default_cfg, busy_scene):
 
 
 def test_no_pellets_turns_the_pellet_effect_off(default_cfg):
-    assert not build_plan(default_cfg, n_pellets=0).on("pellets")
-    assert build_plan(default_cfg, n_pellets=3).on("pellets")
-    assert not build_plan(cfg_with("arena.layout=none")).on("pellets")
+    assert not build_plan(default_cfg, Scene(pellets=False)).on("pellets")
+    assert build_plan(default_cfg, Scene(pellets=True)).on("pellets")
+    assert not build_plan(default_cfg, scene_of(cfg_with("arena.layout=none"))).on("pellets")  # the env's scene
 
 
-def test_pellets_absent_from_the_scene_config_are_not_sensed(busy_scene):
+def test_pellets_absent_from_the_scene_are_not_sensed(busy_scene):
     cfg = cfg_with("arena.layout=none", "physics.image_order=0")
+    plan = build_plan(cfg, scene_of(cfg))
     without = sense(replace(busy_scene, pellet_xy=np.zeros((0, 2)), pellet_orientation=np.zeros(0)), cfg)
-    ignored = sense(busy_scene, cfg)
+    ignored = sense_batch(busy_scene.as_batch(), plan)
     for name in RECEPTORS:
-        np.testing.assert_array_equal(ignored[name], without[name])
+        np.testing.assert_array_equal(ignored[name][0], without[name])
 
 
 def test_emitters_none_turns_induction_and_knollenorgan_off(busy_scene):
     cfg = cfg_with("env.muted=[0,1,2,3]")
-    plan = build_plan(cfg)
+    plan = build_plan(cfg, scene_of(cfg))  # every agent muted: the env's scene has no emitter
     assert not plan.on("eod_emission")
     assert not plan.on("induction")
     assert not plan.on("knollenorgan")
     assert plan.on("ampullary")  # intrinsic fields need no emitter
-    r = sense(busy_scene, cfg)
+    r = {k: v[0] for k, v in sense_batch(busy_scene.as_batch(), plan).items()}
     for name in ("mormyromast", "knollenorgan", "knollen_size"):
         assert np.all(r[name] == 0), name
     assert np.any(r["ampullary"] != 0)
 
 
+def test_the_homing_target_makes_a_muted_scene_emit():
+    cfg = cfg_with("env=homing", "env.muted=[0,1]")
+    assert scene_of(cfg).emitters and build_plan(cfg, scene_of(cfg)).on("eod_emission")
+
+
 def test_nobody_emitting_in_the_snapshot_gives_the_same_as_muted(default_cfg, busy_scene):
     silent = replace(busy_scene, agent_emitting=np.zeros(4, dtype=bool))
-    plan = build_plan(default_cfg, n_pellets=3, any_emitter=False)
+    plan = build_plan(default_cfg, Scene.of_batch(silent.as_batch()))
     assert not plan.on("induction") and not plan.on("knollenorgan")
     r = sense(silent, default_cfg)
     for name in ("mormyromast", "knollenorgan", "knollen_size"):
@@ -129,7 +137,7 @@ def test_closed_gates_turn_induction_off():
 
 
 def test_single_agent_scene_has_no_conspecific_effects():
-    plan = build_plan(cfg_with("env.n_agents=1"))
+    plan = build_plan(cfg_with(), Scene(agents=1))
     assert not plan.on("knollenorgan") and not plan.on("cons_part")
 
 
@@ -195,7 +203,7 @@ def test_ampullary_interference_while_a_conspecific_emits(default_cfg):
     # U(0, 2) on Ampullary readings when any *other* agent emits: much larger spread
     s = random_snapshot(np.random.default_rng(3), 2, 60, emitting=np.array([False, True]))
     plain = sense(s, default_cfg, return_raw=True)
-    from efish.physics.reference import RawReadings
+    from efish.physics.readings import RawReadings
     from efish.sensors.noise import apply_noise
     raw = RawReadings(plain["mormyromast_raw"][None], plain["ampullary_raw"][None], plain["knollenorgan_raw"][None])
     plan = build_plan(default_cfg)

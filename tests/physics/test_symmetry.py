@@ -23,7 +23,7 @@ import numpy as np
 import pytest
 
 from efish import Snapshot, sense
-from efish.sensors import ampullary_angles, knollenorgan_angles, mormyromast_angles
+from efish.physics import ampullary_angles, knollenorgan_angles, mormyromast_angles
 
 from ..conftest import cfg_with, random_snapshot
 

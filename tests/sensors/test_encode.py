@@ -1,6 +1,6 @@
 """The fused encoder (noise + normalisation + binarisation + layout in one pass) against the unfused numpy oracle.
 
-Oracle: ``apply_noise`` then ``efish.sensing.normalise`` (what ``sense_batch``
+Oracle: ``apply_noise`` then ``efish.sensors.sense.normalise`` (what ``sense_batch``
 does), Knollenorgan slots padded to the layout, cast to float32. Known answers
 are required bit for bit, -0.0 included.
 """
@@ -10,11 +10,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from efish.physics import build_plan
-from efish.physics.reference import RawReadings
-from efish.sensing import normalise
+from efish.physics import Scene, build_plan
+from efish.physics.readings import RawReadings
 from efish.sensors.encode import electric_width, encode_readings
 from efish.sensors.noise import apply_noise, noise_uniforms
+from efish.sensors.sense import normalise
 
 from ..conftest import cfg_with
 
@@ -69,7 +69,7 @@ def encoded(raw, emitting, size, plan, slots, rng, width_extra=3) -> np.ndarray:
 @pytest.mark.parametrize("noise", [True, False])
 def test_encoder_equals_the_unfused_composition_bit_for_bit(dtype, n, slots, noise):
     rng = np.random.default_rng(n * 10 + slots)
-    plan = build_plan(cfg_with(), dtype=dtype, n_agents=n)
+    plan = build_plan(cfg_with(), Scene(agents=n), dtype=dtype)
     for _ in range(3):
         raw = random_raw(rng, 5, n, plan, dtype)
         emitting = rng.random((5, n)) < 0.5
@@ -86,7 +86,7 @@ def test_encoder_equals_the_unfused_composition_bit_for_bit(dtype, n, slots, noi
                                  "sensors.knollenorgan.enabled=false", "sensors.noise.enabled=false"])
 def test_encoder_follows_the_plan_switches(off):
     rng = np.random.default_rng(1)
-    plan = build_plan(cfg_with(off), n_agents=4)
+    plan = build_plan(cfg_with(off), Scene(agents=4))
     raw = random_raw(rng, 3, 4, plan, np.float64)
     emitting, size = rng.random((3, 4)) < 0.5, rng.uniform(0, 1, (3, 4))
     noise = np.random.default_rng(2) if plan.noise else None
@@ -97,7 +97,7 @@ def test_encoder_follows_the_plan_switches(off):
 def test_noise_uniforms_reproduce_the_four_uniform_calls_of_the_spec():
     # SPEC 3.4 noise as four Generator.uniform calls (Mormyromast, Ampullary, interference, Knollenorgan):
     # one rng.random call with low + (high - low) * u gives the same numbers and leaves the same state.
-    plan = build_plan(cfg_with(), n_agents=3)
+    plan = build_plan(cfg_with(), Scene(agents=3))
     raw = random_raw(np.random.default_rng(0), 2, 3, plan, np.float64)
     (lo, hi), (jlo, jhi) = plan.noise_range, plan.interference_range
     a, b = np.random.default_rng(9), np.random.default_rng(9)
@@ -112,7 +112,7 @@ def test_noise_uniforms_reproduce_the_four_uniform_calls_of_the_spec():
 
 
 def test_encoder_rejects_bad_buffers():
-    plan = build_plan(cfg_with(), n_agents=4)
+    plan = build_plan(cfg_with(), Scene(agents=4))
     raw = random_raw(np.random.default_rng(0), 1, 4, plan, np.float64)
     e, s = np.zeros((1, 4), bool), np.zeros((1, 4))
     with pytest.raises(TypeError, match="float32"):

@@ -20,7 +20,7 @@ import pandas as pd
 
 from ..config.schema import EfishConfig
 from ..physics.plan import build_plan
-from ..sensing import sense_batch
+from ..sensors.sense import sense_batch
 from .physics import READING_KEYS
 from .scenes import benchmark_batch
 from .timing import best_time

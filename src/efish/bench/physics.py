@@ -6,7 +6,7 @@ import numpy as np
 
 from ..config.schema import EfishConfig
 from ..physics.plan import build_plan
-from ..sensing import sense_batch
+from ..sensors.sense import sense_batch
 from .scenes import benchmark_batch
 from .timing import best_time, best_times_interleaved
 

@@ -20,7 +20,8 @@ def benchmark_snapshot(cfg: EfishConfig, rng: np.random.Generator, foraging: boo
     a = cfg.arena
     n = cfg.env.n_agents
     pellets = sample_pellets(a, rng)
-    xy = spawn_agents(n, a.width_cm, a.height_cm, a.wall_margin_cm, rng)
+    r = cfg.physics.agent_radius_cm
+    xy = spawn_agents(n, a.width_cm, a.height_cm, a.wall_margin_cm, r, rng)
     if foraging and len(pellets):
         for i in range(n):
             for _ in range(100):
@@ -28,7 +29,7 @@ def benchmark_snapshot(cfg: EfishConfig, rng: np.random.Generator, foraging: boo
                 p = np.clip(target + rng.uniform(-10, 10, 2), a.wall_margin_cm,
                             (a.width_cm - a.wall_margin_cm, a.height_cm - a.wall_margin_cm))
                 others = np.delete(xy, i, axis=0)
-                if np.min(np.linalg.norm(others - p, axis=1), initial=np.inf) >= 2.0:
+                if np.min(np.linalg.norm(others - p, axis=1), initial=np.inf) >= 2 * r:
                     xy[i] = p
                     break
     return Snapshot(agent_xy=xy, agent_heading=rng.uniform(-np.pi, np.pi, n),

@@ -14,6 +14,7 @@ import time
 import torch
 
 from ..config.schema import EfishConfig
+from ..env.observe import observation_size
 from ..rl.mappo import Rollout, ppo_update
 from ..rl.networks import Actor, Critic
 from ..rl.value_norm import ValueNormalizer
@@ -67,16 +68,14 @@ def update_rate(cfg: EfishConfig, obs_dim: int, n_agents: int, sequences: int, s
 def rollout_rate(cfg: EfishConfig, steps: int) -> float:
     """Env-steps/s (arena steps x arenas) of collecting a rollout with an untrained policy."""
     from ..env.vec_env import VecEnv
-    from ..rl.train import Learner, collect
+    from ..rl.train import Learner, collect, initial_carry
 
     t = dataclasses.replace(cfg.train, rollout_steps=steps, chunk=steps)
     run = dataclasses.replace(cfg, train=t)
     env = VecEnv(run, num_envs=t.num_envs, seed=0)
     obs = env.reset()
     learner = Learner(run, obs.shape[-1], env.n)
-    s = env.num_envs * env.n
-    carry = {"obs": obs, "h_actor": torch.zeros(s, t.hidden), "h_critic": torch.zeros(s, t.hidden),
-             "starts": torch.ones(s), "episode_return": __import__("numpy").zeros(s)}
+    carry = initial_carry(obs, t.hidden)
     t0 = time.perf_counter()
     collect(run, env, learner, carry, torch.Generator().manual_seed(0))
     return steps * t.num_envs / (time.perf_counter() - t0)
@@ -86,7 +85,7 @@ def bench_train(cfg: EfishConfig, hiddens: tuple[int, ...], rollout_steps: int =
     """One row per (hidden width, precision): the update timed at the configured pass shape
     (:func:`timed_sequences` x ``train.chunk``), a short rollout, and the end-to-end rate they imply."""
     torch.set_num_threads(cfg.train.threads)
-    obs_dim, n_agents = 110, cfg.env.n_agents
+    obs_dim, n_agents = observation_size(cfg), cfg.env.n_agents
     peaks = {"fp32": gemm_flops(torch.float32)}
     bf16_ok = torch.backends.mkldnn.is_available() and "AVX512" in torch.backends.cpu.get_cpu_capability()
     if bf16_ok:

@@ -39,8 +39,9 @@ class PhysicsConfig:
     eps0: float = param(8.854e-12, "vacuum permittivity, F/m", lo=0.0)
     eod_charge_c: float = param(1.11e-15, "EOD monopole charge q, C", lo=0.0)
     eod_half_separation_cm: float = param(0.5, "EOD monopoles sit at +-this along the body axis, cm", lo=0.0, hi=1.0)
-    agent_radius_cm: float = param(1.0, "agent body radius (induction), cm", lo=0.0)
-    pellet_radius_cm: float = param(0.25, "pellet radius (induction), cm", lo=0.0)
+    agent_radius_cm: float = param(1.0, "agent body radius, cm: centres stay 2 radii apart and 1 from walls; "
+                                   "induction radius; the sensors sit on this circle", lo=0.0)
+    pellet_radius_cm: float = param(0.25, "pellet radius (induction, ray hits), cm", lo=0.0)
     agent_dipole_cm: float = param(1.11e-23, "agent intrinsic dipole along body +x, C*m")
     pellet_dipole_cm: float = param(1.11e-24, "pellet intrinsic dipole along pellet +y, C*m")
     susceptibility: float = param(-0.5, "chi of bodies in water (negative: insulator)", lo=-10.0, hi=10.0)
@@ -109,7 +110,6 @@ class NoiseConfig:
 class SensorsConfig:
     """Receptor classes, their layout, ranges, gates and noise (SPEC 3)."""
 
-    sensor_radius_cm: float = param(1.0, "sensors sit on this circle around the body centre, cm", lo=0.0)
     perception: str = param("electric", "electric fields or the ray-casting baseline", choices=("electric", "raycast"))
     mormyromast: MormyromastConfig = group(MormyromastConfig)
     ampullary: AmpullaryConfig = group(AmpullaryConfig)
@@ -170,7 +170,6 @@ class EnvConfig:
     speed_gain: float = param(2.0, "see speed_m_s", lo=0.0)
     turn_rad_s: float = param(3.6, "w_max = turn * turn_gain * (1 + size), rad/s", lo=0.0)
     turn_gain: float = param(4.0, "see turn_rad_s", lo=0.0)
-    body_radius_cm: float = param(1.0, "agent radius; centres stay 2 radii apart, 1 radius from walls", lo=0.0)
     eat_radius_cm: float = param(2.0, "a pellet centre this close and within the eat angle is eaten", lo=0.0)
     eat_half_angle_deg: float = param(22.5, "eat zone: +-this from the heading, degrees", lo=0.0, hi=180.0)
     bite_radius_cm: float = param(3.0, "another agent this close and within the bite angle is bitten", lo=0.0)

@@ -9,11 +9,9 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
-from numba import njit
 
+from .._jit import njit
 from ..config.schema import ArenaConfig
-
-AGENT_RADIUS_CM = 1.0  # bodies are 1 cm circles (SPEC 1); non-overlap means centres >= 2 cm apart
 
 
 def sample_arena(cfg: ArenaConfig, rng: np.random.Generator) -> ArenaConfig:
@@ -165,15 +163,15 @@ def _concat(parts: list[np.ndarray]) -> np.ndarray:
     return np.concatenate(parts) if parts else np.zeros((0, 2))
 
 
-def spawn_agents(n: int, width: float, height: float, margin: float, rng: np.random.Generator,
+def spawn_agents(n: int, width: float, height: float, margin: float, radius: float, rng: np.random.Generator,
                  max_tries: int = 10_000) -> np.ndarray:
-    """``n`` agent centres uniform in the arena with a wall margin and no overlap (centres >= 2 cm apart)."""
+    """``n`` agent centres uniform in the arena with a wall margin and no overlap (centres >= 2 radii apart)."""
     lo, hi = (margin, margin), (width - margin, height - margin)
     xy = np.zeros((0, 2))
     for _ in range(max_tries):
         if len(xy) == n:
             return xy
         p = rng.uniform(lo, hi)
-        if len(xy) == 0 or np.min(np.linalg.norm(xy - p, axis=1)) >= 2 * AGENT_RADIUS_CM:
+        if len(xy) == 0 or np.min(np.linalg.norm(xy - p, axis=1)) >= 2 * radius:
             xy = np.vstack([xy, p])
     raise ValueError(f"could not place {n} agents without overlap in a {width:g} x {height:g} cm arena")

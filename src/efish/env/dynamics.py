@@ -8,19 +8,32 @@ every agent has moved. Pure functions of arrays; (B, N) leading dimensions.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from .._jit import njit
 
 # Indices into the ``p`` parameter array.
 EAT_R2, EAT_COS, BITE_R2, BITE_COS, MIN_SEP2, WALL, EAT_CD, BITE_CD, N_PARAMS = range(9)
 
 
+def body_params(env, body_radius_cm: float) -> np.ndarray:
+    """float64[N_PARAMS]: the eat and bite zones, separations and cooldowns the kernels read (``env``: EnvConfig)."""
+    p = np.zeros(N_PARAMS)
+    p[EAT_R2], p[BITE_R2] = env.eat_radius_cm ** 2, env.bite_radius_cm ** 2
+    p[EAT_COS] = np.cos(np.radians(env.eat_half_angle_deg))
+    p[BITE_COS] = np.cos(np.radians(env.bite_half_angle_deg))
+    p[MIN_SEP2], p[WALL] = (2 * body_radius_cm) ** 2, body_radius_cm
+    p[EAT_CD], p[BITE_CD] = env.eat_cooldown, env.bite_cooldown
+    return p
+
+
 @njit(cache=True)
-def map_actions(actions, bots, muted, target, homing, move, turn, eod, bite, no_eating):
+def map_actions(actions, bots, muted, forced_eod, no_bite, move, turn, eod, bite, no_eating):
     """Raw policy outputs to commands for B arenas (SPEC 5); returns False if any action is not finite.
 
     ``actions`` float64[B, N, 4] (a_move, a_turn, eod, bite): move = sigmoid(a_move),
-    turn = tanh(a_turn), eod = (eod > 0.5) unless muted, always for the homing
-    target; bite = bite > 0.5, never for bots nor in the homing task. Bots enter
+    turn = tanh(a_turn), eod = (eod > 0.5) unless muted, always for agents the
+    task forces to emit; bite = bite > 0.5, never for agents in ``no_bite``
+    (bots, and every agent of a task without biting). Bots enter
     eating as if biting (``no_eating``): they never eat. One pass instead of a
     dozen small numpy calls, which cost more than the work at this size.
     """
@@ -31,8 +44,8 @@ def map_actions(actions, bots, muted, target, homing, move, turn, eod, bite, no_
             finite = finite and np.isfinite(a[0]) and np.isfinite(a[1]) and np.isfinite(a[2]) and np.isfinite(a[3])
             move[b, i] = 0.5 * (1.0 + np.tanh(0.5 * a[0]))  # overflow-free logistic
             turn[b, i] = np.tanh(a[1])
-            eod[b, i] = (a[2] > 0.5 and not muted[i]) or target[i]
-            bite[b, i] = a[3] > 0.5 and not bots[i] and not homing
+            eod[b, i] = (a[2] > 0.5 and not muted[i]) or forced_eod[i]
+            bite[b, i] = a[3] > 0.5 and not no_bite[i]
             no_eating[b, i] = bite[b, i] or bots[i]
     return finite
 
@@ -128,19 +141,6 @@ def resolve_bites(xy, heading, size, bite, can_bite, bite_cd, p, bitten_by, bit,
                 bite_cd[b, i] = int(p[BITE_CD])
                 bitten_by[b, victim] += 1
                 penalty_bitten[b, victim] += 1.0 + size[b, i] - size[b, victim]
-
-
-@njit(cache=True)
-def nearest_pellet_distance(xy, pellet_xy, alive, out):
-    """Distance (cm) from each agent to its nearest live pellet; NaN when none is left."""
-    for b in range(xy.shape[0]):
-        for i in range(xy.shape[1]):
-            best = np.inf
-            for k in range(pellet_xy.shape[1]):
-                if alive[b, k]:
-                    d2 = (pellet_xy[b, k, 0] - xy[b, i, 0]) ** 2 + (pellet_xy[b, k, 1] - xy[b, i, 1]) ** 2
-                    best = min(best, d2)
-            out[b, i] = np.sqrt(best) if best < np.inf else np.nan
 
 
 @njit(cache=True)

@@ -11,7 +11,10 @@ eat cooldown / eat_cooldown 1 | reserved 1. Unused Knollenorgan slots are 0.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from .._jit import njit
+from ..config.schema import EfishConfig
+from ..sensors.encode import electric_width
 
 TAIL_NAMES = ("last_action", "was_bitten", "own_size", "bite_cooldown", "displacement", "eat_cooldown", "reserved")
 TAIL_SIZES = (4, 1, 1, 1, 2, 1, 1)
@@ -20,6 +23,19 @@ TAIL_SIZES = (4, 1, 1, 1, 2, 1, 1)
 def _slices(names, sizes) -> dict[str, slice]:
     edges = np.cumsum((0,) + tuple(sizes))
     return {k: slice(int(a), int(b)) for k, a, b in zip(names, edges[:-1], edges[1:])}
+
+
+def perception_width(cfg: EfishConfig) -> int:
+    """Length of the sensory block: the electric receptors (SPEC 4) or the rays of the baseline."""
+    se = cfg.sensors
+    if se.perception == "raycast":
+        return 2 * se.ray_count
+    return electric_width(se.mormyromast.count, se.ampullary.count, se.knollenorgan.count, cfg.env.obs_agents - 1)
+
+
+def observation_size(cfg: EfishConfig) -> int:
+    """Length of one agent's observation vector (110 with the defaults, 83 with ray casting)."""
+    return perception_width(cfg) + sum(TAIL_SIZES)
 
 
 def observation_slices(n_morm: int, n_amp: int, n_knoll: int, obs_agents: int) -> dict[str, slice]:

@@ -8,7 +8,8 @@ the kind of thing: none 0, food 1/3, agent 2/3, wall 1.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from .._jit import njit
 
 KIND_NONE, KIND_FOOD, KIND_AGENT, KIND_WALL = 0.0, 1.0 / 3.0, 2.0 / 3.0, 1.0
 

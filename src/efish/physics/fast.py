@@ -7,9 +7,10 @@ import weakref
 import numpy as np
 
 from . import kernels as kn
+from .far_field import flat_far_tables, level_tables
 from .plan import CM, EffectPlan
+from .readings import RawReadings, empty_readings
 from .sense_kernel import sense_batch_kernel
-from .reference import RawReadings, empty_readings
 from .snapshot import SnapshotBatch
 
 
@@ -93,30 +94,3 @@ def fast_raw(batch: SnapshotBatch, plan: EffectPlan) -> RawReadings:
         arr(batch.pellet_xy, CM), arr(batch.pellet_orientation), np.ascontiguousarray(batch.pellet_alive),
         arr(batch.width, CM), arr(batch.height, CM), *inputs, out.mormyromast, out.ampullary, out.knollenorgan)
     return out
-
-
-def level_tables(plan: EffectPlan) -> tuple[np.ndarray, np.ndarray]:
-    """Lookup tables of the far-field level choice (see ``sense_kernel.interpolation_level``).
-
-    level_lcq: log2(C Q) per level; level_e: the order (Q + 1) / 2 per level.
-    """
-    q = np.array(plan.far_levels, dtype=np.float64)
-    return np.log2(plan.far_safety * q), (q + 1) // 2
-
-
-def flat_far_tables(plan: EffectPlan) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The far-field levels' points and interpolation matrices stacked level after level.
-
-    Returns offsets (int64[L + 1], level l owns rows offsets[l]:offsets[l + 1]),
-    points (2, sum Q) cos and sin of the point angles, and the interpolation
-    matrices (sum Q, 36) and (sum Q, 24), transposed so that each point adds
-    one contiguous row to every sensor of a class.
-    """
-    q = np.array(plan.far_levels, dtype=np.int64)
-    offsets = np.concatenate([[0], np.cumsum(q)]).astype(np.int64)
-    blocks = [(plan.far_tables[i, :, :n], plan.morm_interp[i, :, :n], plan.amp_interp[i, :, :n])
-              for i, n in enumerate(q)]
-    points = np.concatenate([b[0] for b in blocks], axis=1) if blocks else np.zeros((2, 0))
-    morm = np.concatenate([b[1] for b in blocks], axis=1) if blocks else np.zeros((len(plan.morm_angles), 0))
-    amp = np.concatenate([b[2] for b in blocks], axis=1) if blocks else np.zeros((len(plan.amp_angles), 0))
-    return offsets, points, np.ascontiguousarray(morm.T), np.ascontiguousarray(amp.T)

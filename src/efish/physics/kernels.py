@@ -17,7 +17,8 @@ The per-agent assembly lives in :mod:`efish.physics.sense_kernel`.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from .._jit import njit
 
 # Indices into the ``consts`` array (module-level ints are compile-time constants).
 K, Q, HALF_SEP, P_AGENT, P_PELLET, ALPHA_AGENT, ALPHA_PELLET, SOFT2, R_SENS = range(9)

@@ -1,8 +1,11 @@
 """The effect plan: simulate only what the scene calls for.
 
-The config says which effects exist (physics switches, receptor classes,
-gates, the arena's food layout, the env's agents and who is muted);
-:func:`build_plan` turns it into an :class:`EffectPlan` once per episode. Kernels for absent effects are
+The physics and sensors configs say which effects exist (physics switches,
+receptor classes, gates); a :class:`Scene` says what the scene holds (how many
+agents, whether any may emit, whether there are pellets). The simulator knows
+no task: the environment (or ``efish.sense``, from a snapshot) describes the
+scene, and :func:`build_plan` turns both into an :class:`EffectPlan` once per
+episode. Kernels for absent effects are
 not called at all, and every number the kernels need is derived here in SI
 units, so kernels never see a config. ``efish plan <overrides>`` prints
 :meth:`EffectPlan.explain`.
@@ -28,11 +31,32 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..config.schema import EfishConfig
-from ..sensors.layout import ampullary_angles, even_angles, knollenorgan_angles, mormyromast_angles
+from .far_field import far_field_tables
 from .fields import coulomb_constant
+from .geometry import ampullary_angles, knollenorgan_angles, mormyromast_angles
 from .images import image_indices, image_weights
 
 CM = 0.01  # m per cm
+
+
+@dataclass(frozen=True)
+class Scene:
+    """What a scene holds, as far as the fields care.
+
+    The defaults describe a scene with every effect the config allows: several
+    agents, emitters and pellets. ``efish.env`` derives it from the task and
+    the interventions; :meth:`of_batch` from given snapshots.
+    """
+
+    agents: int = 2        # agents per arena (1: no conspecific channels)
+    emitters: bool = True  # some agent may emit an EOD (False: no induction, no Knollenorgan spikes)
+    pellets: bool = True   # some pellet may exist (False: no pellet loops)
+
+    @classmethod
+    def of_batch(cls, batch) -> "Scene":
+        """The scene of known snapshots (a :class:`~efish.physics.snapshot.SnapshotBatch`)."""
+        return cls(agents=int(batch.shape[1]), emitters=bool(np.any(batch.agent_emitting)),
+                   pellets=bool(np.any(batch.pellet_alive)))
 
 
 @dataclass(frozen=True)
@@ -112,26 +136,23 @@ class EffectPlan:
         return "\n".join(lines)
 
 
-def build_plan(cfg: EfishConfig, *, tolerance: float | None = None, dtype: str | None = None,
-               n_pellets: int | None = None, any_emitter: bool | None = None,
-               n_agents: int | None = None) -> EffectPlan:
-    """Decide which effects run for the scene in ``cfg`` and derive the kernel constants.
+def build_plan(cfg: EfishConfig, scene: Scene | None = None, *, tolerance: float | None = None,
+               dtype: str | None = None) -> EffectPlan:
+    """Decide which effects run for ``scene`` under ``cfg.physics`` and ``cfg.sensors``; derive the kernel constants.
 
-    The scene comes from ``cfg.env`` (agents, who is muted, the homing target
-    that always emits) and ``cfg.arena`` (layout ``none`` has no pellets).
-    ``n_pellets``, ``any_emitter`` and ``n_agents`` override it for a known
-    episode (no pellets -> no pellet loops; nobody can emit -> no induction;
-    a lone agent -> no conspecific channels).
+    No pellets -> no pellet loops; nobody can emit -> no induction and no
+    Knollenorgan spikes; a lone agent -> no conspecific channels. ``scene``
+    defaults to :class:`Scene` (every effect the config allows).
     """
-    ph, se, env = cfg.physics, cfg.sensors, cfg.env
-    agents = env.n_agents if n_agents is None else n_agents
+    ph, se = cfg.physics, cfg.sensors
+    scene = scene or Scene()
+    agents = scene.agents
     tol = ph.tolerance if tolerance is None else float(tolerance)
     if not tol >= 0:
         raise ValueError(f"tolerance must be >= 0, got {tolerance}")
     electric = se.perception == "electric"
-    pellets = cfg.arena.layout != "none" and (n_pellets is None or n_pellets > 0)
-    all_muted = set(range(env.n_agents)) <= set(env.muted) and env.task != "homing"
-    emitters = ph.emission and not all_muted and (any_emitter is None or any_emitter)
+    pellets = scene.pellets
+    emitters = ph.emission and scene.emitters
     m_on, a_on, k_on = (electric and se.mormyromast.enabled, electric and se.ampullary.enabled,
                         electric and se.knollenorgan.enabled)
     gates_open = se.mormyromast.g_self > 0 or se.mormyromast.g_cons > 0
@@ -149,7 +170,7 @@ def build_plan(cfg: EfishConfig, *, tolerance: float | None = None, dtype: str |
         Effect("knollenorgan", k_on and emitters and agents > 1,
                "off: no conspecifics" if agents < 2 else
                ("off: nobody can emit, every spike is 0" if k_on and not emitters else why_receptor("knollenorgan", se.knollenorgan.enabled))),
-        Effect("eod_emission", emitters, "agents may emit" if emitters else "off: physics.emission false or every agent muted"),
+        Effect("eod_emission", emitters, "agents may emit" if emitters else "off: physics.emission false or no agent of the scene may emit"),
         Effect("induction", m_on and emitters and ph.induction and gates_open,
                "induced dipoles feed Mormyromasts" if m_on and emitters and ph.induction and gates_open else
                "off: " + ("no Mormyromasts" if not m_on else "no emitters" if not emitters else
@@ -163,7 +184,7 @@ def build_plan(cfg: EfishConfig, *, tolerance: float | None = None, dtype: str |
                else "off: the self part is gated out (g_self = 0)"),
         Effect("intrinsic_fields", a_on and ph.intrinsic, "intrinsic dipoles feed Ampullary organs" if a_on and ph.intrinsic else
                "off: " + ("no Ampullary organs" if not a_on else "physics.intrinsic is false")),
-        Effect("pellets", pellets, "pellet sources in the loops" if pellets else "off: no pellets (arena.layout none)"),
+        Effect("pellets", pellets, "pellet sources in the loops" if pellets else "off: the scene has no pellets"),
         Effect("wall_images", electric and walls, f"image order {ph.image_order}, scale {ph.image_scale:g}" if walls else "off: image order 0 or scale 0"),
         Effect("noise", electric and se.noise.enabled, "multiplicative, seeded" if se.noise.enabled else "off: sensors.noise.enabled is false"),
         Effect("culling", electric and tol > 0, f"sources below {tol:g} x E_min skipped" if tol > 0 else "off: tolerance 0 computes every source"),
@@ -183,7 +204,7 @@ def build_plan(cfg: EfishConfig, *, tolerance: float | None = None, dtype: str |
         alpha_pellet=(ph.pellet_radius_cm * CM) ** 3 * chi / k,
         softening2=ph.softening_m ** 2,
         image_indices=idx, image_weights=image_weights(idx, ph.image_scale), image_scale=ph.image_scale,
-        sensor_radius=se.sensor_radius_cm * CM,
+        sensor_radius=ph.agent_radius_cm * CM,  # the sensors sit on the body circle
         morm_angles=mormyromast_angles(se.mormyromast), amp_angles=ampullary_angles(se.ampullary),
         knollen_angles=knollenorgan_angles(se.knollenorgan),
         far_min=ph.far_field_min_cm * CM, far_safety=ph.far_field_safety,
@@ -197,30 +218,3 @@ def build_plan(cfg: EfishConfig, *, tolerance: float | None = None, dtype: str |
         noise_range=(se.noise.low, se.noise.high),
         interference_range=(se.noise.interference_low, se.noise.interference_high),
     )
-
-
-def trig_interpolation_matrix(targets: np.ndarray, q: int) -> np.ndarray:
-    """Weights W (T, q) with f(targets) ~= W @ f(2 pi k / q) for trigonometric polynomials of degree (q-1)/2.
-
-    The periodic sinc (Dirichlet kernel) for an odd number of equispaced points.
-    """
-    if q % 2 == 0:
-        raise ValueError(f"trigonometric interpolation needs an odd number of points, got {q}")
-    x = targets[:, None] - even_angles(q)[None, :]
-    half = np.sin(x / 2)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        w = np.sin(q * x / 2) / (q * half)
-    return np.where(np.abs(half) < 1e-12, 1.0, w)
-
-
-def far_field_tables(levels: tuple[int, ...], morm_angles: np.ndarray, amp_angles: np.ndarray) -> dict:
-    """Point angles (cos, sin) and interpolation matrices of every far-field level, zero-padded to Qmax."""
-    q_max = max(levels, default=1)
-    tables = np.zeros((len(levels), 2, q_max))
-    morm = np.zeros((len(levels), len(morm_angles), q_max))
-    amp = np.zeros((len(levels), len(amp_angles), q_max))
-    for i, q in enumerate(levels):
-        tables[i, 0, :q], tables[i, 1, :q] = np.cos(even_angles(q)), np.sin(even_angles(q))
-        morm[i, :, :q] = trig_interpolation_matrix(morm_angles, q)
-        amp[i, :, :q] = trig_interpolation_matrix(amp_angles, q)
-    return {"far_levels": tuple(levels), "far_tables": tables, "morm_interp": morm, "amp_interp": amp}

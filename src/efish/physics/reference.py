@@ -7,40 +7,14 @@ for clarity, not speed: it is never used for training.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
-from ..sensors.layout import sensor_frame
 from .fields import dipole_field, monopole_field
+from .geometry import conspecific_slots, sensor_frame
 from .images import image_sources
 from .plan import CM, EffectPlan
+from .readings import RawReadings, empty_readings
 from .snapshot import SnapshotBatch
-
-
-@dataclass
-class RawReadings:
-    """Raw field readings E.n in V/m, before noise and normalisation.
-
-    mormyromast: float[B, N, 36]
-    ampullary: float[B, N, 24]
-    knollenorgan: float[B, N, N-1, 12]  # slot j = j-th other agent in id order
-    morm_self, morm_cons: float[B, N, 36] or None  # ungated parts (reference only)
-    """
-
-    mormyromast: np.ndarray
-    ampullary: np.ndarray
-    knollenorgan: np.ndarray
-    morm_self: np.ndarray | None = None
-    morm_cons: np.ndarray | None = None
-
-
-def empty_readings(b: int, n: int, plan: EffectPlan, dtype=np.float64) -> RawReadings:
-    """All-zero raw readings of the right shapes."""
-    return RawReadings(
-        mormyromast=np.zeros((b, n, len(plan.morm_angles)), dtype),
-        ampullary=np.zeros((b, n, len(plan.amp_angles)), dtype),
-        knollenorgan=np.zeros((b, n, n - 1, len(plan.knollen_angles)), dtype))
 
 
 def eod_monopoles(xy: np.ndarray, heading: np.ndarray, plan: EffectPlan) -> tuple[np.ndarray, np.ndarray]:
@@ -126,7 +100,7 @@ def _reference_env(batch: SnapshotBatch, b: int, plan: EffectPlan, out: RawReadi
                                    + dipoles_at(s_pos, s_n, bodies[a:a + 1], p_int[a:a + 1], skip_identity=True))
         if plan.on("knollenorgan"):
             s_pos, s_n = sensor_frame(xy[a], heading[a], plan.knollen_angles, plan.sensor_radius)
-            for slot, j in enumerate(j for j in range(n) if j != a):
+            for slot, j in enumerate(conspecific_slots(n)[a]):
                 if emitting[j]:
                     pos, q = eod_monopoles(xy[j], heading[j], plan)
                     out.knollenorgan[b, a, slot] = _normal_component(monopole_field(s_pos, pos, q, softening=soft), s_n)

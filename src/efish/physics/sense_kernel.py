@@ -26,17 +26,67 @@ its time in the scalar remainder.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from .._jit import njit
+from .geometry import slot_agent
 from .kernels import (
-    _FASTMATH, ALPHA_AGENT, ALPHA_PELLET, CULL, DO_AMP, DO_INDUCTION, DO_KNOLL, DO_MORM, DO_PELLETS,
-    DO_WALLDIST, G_CONS, G_SELF, HALF_SEP, K, K_CONS, KNOLL_ZERO, M1X, M1Y, M2X, M2Y, N_SRC, ONE,
-    P_AGENT, P_PELLET, Q, R_SENS, SOFT2, SX, SY, THREE, TOL_AMP, TOL_MORM, ZERO, ZERO_AMP, ZERO_MORM,
-    add_monopole, far_readings, image_table, induced_dipoles, place_on_circle, place_sensors,
+    _FASTMATH,
+    ALPHA_AGENT,
+    ALPHA_PELLET,
+    CULL,
+    DO_AMP,
+    DO_INDUCTION,
+    DO_KNOLL,
+    DO_MORM,
+    DO_PELLETS,
+    DO_WALLDIST,
+    G_CONS,
+    G_SELF,
+    HALF_SEP,
+    K_CONS,
+    KNOLL_ZERO,
+    M1X,
+    M1Y,
+    M2X,
+    M2Y,
+    N_SRC,
+    ONE,
+    P_AGENT,
+    P_PELLET,
+    R_SENS,
+    SOFT2,
+    SX,
+    SY,
+    THREE,
+    TOL_AMP,
+    TOL_MORM,
+    ZERO,
+    ZERO_AMP,
+    ZERO_MORM,
+    K,
+    Q,
+    add_monopole,
+    far_readings,
+    image_table,
+    induced_dipoles,
+    place_on_circle,
+    place_sensors,
 )
 from .sources import (
-    BLOCK, L_A1, L_T1X, L_T1Y, N_GEO, N_LIST, N_SHARED, copy_shared, gather_sources, image_rows, imaged_moments,
-    list_images, share_far_sources, weighted_moments,
+    BLOCK,
+    L_A1,
+    L_T1X,
+    L_T1Y,
+    N_GEO,
+    N_LIST,
+    N_SHARED,
+    copy_shared,
+    gather_sources,
+    image_rows,
+    imaged_moments,
+    list_images,
+    share_far_sources,
+    weighted_moments,
 )
 from .trig import sincos
 
@@ -99,11 +149,8 @@ def knollenorgan_env(axy, heading, emitting, cos_k, sin_k, c, flags, out):
     kq = c[K] * c[Q]
     for a in range(n):
         place_sensors(axy[a, 0], axy[a, 1], heading[a], cos_k, sin_k, c[R_SENS], sx, sy, nx, ny)
-        slot = -1
-        for j in range(n):
-            if j == a:
-                continue
-            slot += 1
+        for slot in range(n - 1):
+            j = slot_agent(a, slot)
             if not emitting[j]:
                 continue
             # Mean-value bound on the pair field: |E| <= 2 h * 2 k q / (D - r - h)^3.

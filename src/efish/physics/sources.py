@@ -24,8 +24,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
+from .._jit import njit
 from .kernels import _FASTMATH, FAR_MAX_LS, FAR_MAX_LX, M1X, M1Y, M2X, M2Y, R_SENS, SX, SY
 
 # Rows of a source list (float64), one column per body image; in the arena's full list

@@ -15,7 +15,8 @@ import math
 from decimal import Decimal, getcontext
 
 import numpy as np
-from numba import njit
+
+from .._jit import njit
 
 
 def _pio2_parts() -> tuple[float, float, float]:

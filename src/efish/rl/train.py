@@ -21,6 +21,7 @@ import torch
 from ..config.schema import EfishConfig
 from ..env.vec_env import VecEnv
 from ..io import atomic_path
+from ..physics.geometry import conspecific_slots
 from .advantages import gae
 from .mappo import Rollout, ppo_update
 from .networks import Actor, Critic
@@ -35,7 +36,7 @@ METRICS = "metrics.parquet"
 def agent_centric_state(obs: np.ndarray) -> np.ndarray:
     """[B, N, D] -> [B, N, N*D]: each agent's critic input, its own observation first, then the others in id order."""
     n = obs.shape[1]
-    order = np.array([[i] + [j for j in range(n) if j != i] for i in range(n)])
+    order = np.concatenate([np.arange(n)[:, None], conspecific_slots(n)], axis=1)
     return obs[:, order].reshape(obs.shape[0], n, -1)
 
 
@@ -51,6 +52,14 @@ class Learner:
         self.actor_opt = torch.optim.Adam(self.actor.parameters(), lr=t.lr, eps=t.adam_eps, weight_decay=t.weight_decay)
         self.critic_opt = torch.optim.Adam(self.critic.parameters(), lr=t.lr, eps=t.adam_eps, weight_decay=t.weight_decay)
         self.architecture = {"obs_dim": obs_dim, "n_agents": n_agents, "hidden": t.hidden}
+
+
+def initial_carry(obs: np.ndarray, hidden: int) -> dict:
+    """What a rollout hands to the next: the last observation [B, N, D], both networks' hidden states [B*N, H],
+    episode starts and the running episode return [B*N] (all episodes start now)."""
+    s = obs.shape[0] * obs.shape[1]
+    return {"obs": obs, "h_actor": torch.zeros(s, hidden), "h_critic": torch.zeros(s, hidden), "starts": torch.ones(s),
+            "episode_return": np.zeros(s)}
 
 
 def collect(cfg: EfishConfig, env: VecEnv, learner: Learner, carry: dict, generator: torch.Generator
@@ -123,9 +132,7 @@ def train(cfg: EfishConfig, out_dir: str | Path, progress=None) -> pd.DataFrame:
     obs = env.reset()  # bad env settings fail here, before anything is written
     out.mkdir(parents=True, exist_ok=True)
     learner = Learner(cfg, obs.shape[-1], env.n)
-    S, H = env.num_envs * env.n, t_cfg.hidden
-    carry = {"obs": obs, "h_actor": torch.zeros(S, H), "h_critic": torch.zeros(S, H), "starts": torch.ones(S),
-             "episode_return": np.zeros(S)}
+    carry = initial_carry(obs, t_cfg.hidden)
     generator = torch.Generator().manual_seed(t_cfg.seed)
     rows, update = [], 0
     if (out / CHECKPOINT).exists():

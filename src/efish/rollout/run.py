@@ -6,6 +6,7 @@ import numpy as np
 import pandas as pd
 
 from ..config.schema import EfishConfig
+from ..env.geometry import nearest_pellet
 from ..env.observe import observation_slices
 from ..env.vec_env import VecEnv
 
@@ -16,7 +17,8 @@ def _wrap(a: np.ndarray) -> np.ndarray:
 
 def nearest(env: VecEnv) -> dict[str, np.ndarray]:
     """Distance (cm) and bearing (rad, from the heading) to the nearest agent, pellet and wall; [B, N] each."""
-    xy, h = env.xy, env.heading
+    s = env.state
+    xy, h = s.xy, s.heading
     d = xy[:, None, :, :] - xy[:, :, None, :]                       # [B, N(i), N(j), 2]: j - i
     dist = np.linalg.norm(d, axis=-1) + np.where(np.eye(env.n, dtype=bool), np.inf, 0.0)
     j = dist.argmin(axis=-1)
@@ -24,14 +26,12 @@ def nearest(env: VecEnv) -> dict[str, np.ndarray]:
     out = {"dist_agent_cm": dist.min(axis=-1), "bearing_agent_rad": _wrap(np.arctan2(pick[..., 1], pick[..., 0]) - h)}
     if env.n == 1:
         out["dist_agent_cm"][:], out["bearing_agent_rad"][:] = np.nan, np.nan
-    p = env.pellet_xy[:, None, :, :] - xy[:, :, None, :]             # [B, N, P, 2]
-    pd_ = np.where(env.alive[:, None, :], np.linalg.norm(p, axis=-1), np.inf)
-    k = pd_.argmin(axis=-1) if pd_.shape[-1] else np.zeros(h.shape, int)
-    has = np.isfinite(pd_.min(axis=-1)) if pd_.shape[-1] else np.zeros(h.shape, bool)
-    pk = np.take_along_axis(p, k[..., None, None], axis=2)[:, :, 0] if pd_.shape[-1] else np.zeros(xy.shape)
-    out["dist_food_cm"] = np.where(has, pd_.min(axis=-1) if pd_.shape[-1] else np.nan, np.nan)
-    out["bearing_food_rad"] = np.where(has, _wrap(np.arctan2(pk[..., 1], pk[..., 0]) - h), np.nan)
-    walls = np.stack([xy[..., 0], env.width[:, None] - xy[..., 0], xy[..., 1], env.height[:, None] - xy[..., 1]], -1)
+    dist_food, k = np.empty(h.shape), np.empty(h.shape, np.int64)
+    nearest_pellet(xy, s.pellet_xy, s.alive, dist_food, k)
+    pk = np.take_along_axis(s.pellet_xy, np.maximum(k, 0)[..., None], axis=1) - xy   # [B, N, 2]
+    out["dist_food_cm"] = dist_food
+    out["bearing_food_rad"] = np.where(k >= 0, _wrap(np.arctan2(pk[..., 1], pk[..., 0]) - h), np.nan)
+    walls = np.stack([xy[..., 0], s.width[:, None] - xy[..., 0], xy[..., 1], s.height[:, None] - xy[..., 1]], -1)
     w = walls.argmin(axis=-1)
     out["dist_wall_cm"] = walls.min(axis=-1)
     out["bearing_wall_rad"] = _wrap(np.array([np.pi, 0.0, -np.pi / 2, np.pi / 2])[w] - h)
@@ -56,13 +56,13 @@ def run_episodes(cfg: EfishConfig, policy, episodes: int, condition: str = "cont
     steps, bites_recv = [], np.zeros((B, N), int)
     for t in range(T):
         actions, hidden = policy.act(obs, hidden, starts, deterministic)
-        alive_before = env.alive.copy()
+        alive_before = env.state.alive.copy()
         obs, reward, term, trunc, info = env.step(actions)
         food.update(env, alive_before, t)
         row = {
             "episode": np.repeat(np.arange(B), N), "t": np.full(B * N, t), "agent": np.tile(np.arange(N), B),
-            "x_cm": env.xy[..., 0].ravel(), "y_cm": env.xy[..., 1].ravel(), "heading_rad": env.heading.ravel(),
-            "size": env.size.ravel(), "move": info["move"].ravel(), "turn": info["turn"].ravel(),
+            "x_cm": env.state.xy[..., 0].ravel(), "y_cm": env.state.xy[..., 1].ravel(),
+            "heading_rad": env.state.heading.ravel(), "size": env.state.size.ravel(), "move": info["move"].ravel(), "turn": info["turn"].ravel(),
             "eod": info["eod"].ravel(), "bite": info["bite"].ravel(), "ate": info["ate"].ravel(),
             "bit": info["bit"].ravel(), "was_bitten": info["was_bitten"].ravel(),
             "collided": info["collided"].ravel(), "reward": reward.ravel(),
@@ -100,21 +100,22 @@ class FoodLog:
 
     def __init__(self, env: VecEnv):
         self.records: list[list] = []              # [episode, pellet id, x, y, t_spawned, t_eaten]
-        self.slot = np.full(env.alive.shape, -1)  # record index currently in each slot
-        self.count = np.zeros(env.alive.shape[0], int)  # pellets seen so far per episode
-        for b, k in zip(*np.nonzero(env.alive)):
+        self.slot = np.full(env.state.alive.shape, -1)  # record index currently in each slot
+        self.count = np.zeros(env.state.alive.shape[0], int)  # pellets seen so far per episode
+        for b, k in zip(*np.nonzero(env.state.alive)):
             self._spawn(env, b, k, 0)
 
     def _spawn(self, env: VecEnv, b: int, k: int, t: int) -> None:
         self.slot[b, k] = len(self.records)
-        self.records.append([b, self.count[b], env.pellet_xy[b, k, 0], env.pellet_xy[b, k, 1], t, -1])
+        self.records.append([b, self.count[b], env.state.pellet_xy[b, k, 0], env.state.pellet_xy[b, k, 1], t, -1])
         self.count[b] += 1
 
     def update(self, env: VecEnv, alive_before: np.ndarray, t: int) -> None:
         """Record pellets eaten and regrown during step ``t``."""
-        for b, k in zip(*np.nonzero(alive_before & ~env.alive)):
+        alive = env.state.alive
+        for b, k in zip(*np.nonzero(alive_before & ~alive)):
             self.records[self.slot[b, k]][5] = t
-        for b, k in zip(*np.nonzero(~alive_before & env.alive)):
+        for b, k in zip(*np.nonzero(~alive_before & alive)):
             self._spawn(env, b, k, t)
 
     def table(self) -> pd.DataFrame:

@@ -1,7 +1,10 @@
-"""Receptor layouts, transduction and normalisation."""
+"""From raw field readings to what an agent perceives: noise, normalisation, encoding, ``sense``.
 
-from .layout import ampullary_angles, knollenorgan_angles, mormyromast_angles, sensor_frame
+Sensor geometry (where the receptors sit) belongs to the physics
+(:mod:`efish.physics.geometry`); this layer turns raw V/m readings into the
+normalised values of SPEC 3.4.
+"""
+
 from .normalize import binarize, knollen_size_channel, log_normalize
 
-__all__ = ["ampullary_angles", "binarize", "knollen_size_channel", "knollenorgan_angles",
-           "log_normalize", "mormyromast_angles", "sensor_frame"]
+__all__ = ["binarize", "knollen_size_channel", "log_normalize"]

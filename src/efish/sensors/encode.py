@@ -5,7 +5,7 @@ normalisation, Knollenorgan binarisation, the size channel and the layout of
 SPEC 4. Done as separate numpy calls these are a dozen small passes with
 temporaries; :func:`encode_readings` does them in one numba loop that writes
 straight into the float32 observation. The unfused composition
-(:func:`efish.sensing.sense_batch`, i.e. ``apply_noise`` then ``normalise``)
+(:func:`efish.sensors.sense.sense_batch`, i.e. ``apply_noise`` then ``normalise``)
 stays as the public ``sense`` API and is the oracle this kernel is tested
 against, bit for bit.
 
@@ -19,10 +19,11 @@ from __future__ import annotations
 import weakref
 
 import numpy as np
-from numba import njit
 
+from .._jit import njit
+from ..physics.geometry import slot_agent
 from ..physics.plan import EffectPlan
-from ..physics.reference import RawReadings
+from ..physics.readings import RawReadings
 
 # Indices into the float64 ``lin`` constants.
 LO, SCALE, JAM_LO, JAM_SCALE, M_EMIN, M_EMAX, M_LMIN, M_SPAN, A_EMIN, A_EMAX, A_LMIN, A_SPAN, N_LIN = range(13)
@@ -137,7 +138,7 @@ def noisy_kernel(morm, amp, knoll, u, emitting, size, lin, typed, flags, slots, 
                     heard = heard or spike != 0.0
                     out[b, i, k0 + j * n_k + k] = spike
                 if heard:
-                    out[b, i, s0 + j] = typed[HALF] + typed[HALF] * as_raw(size[b, j if j < i else j + 1])
+                    out[b, i, s0 + j] = typed[HALF] + typed[HALF] * as_raw(size[b, slot_agent(i, j)])
                 else:
                     out[b, i, s0 + j] = 0.0
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..physics.plan import EffectPlan
-from ..physics.reference import RawReadings
+from ..physics.readings import RawReadings
 
 
 def noise_uniforms(raw: RawReadings, rng: np.random.Generator, out: np.ndarray | None = None) -> np.ndarray:

@@ -1,9 +1,10 @@
-"""Where the sensors sit on the body (SPEC 3): angles from the heading, radians."""
+"""Where the sensors sit on the body (SPEC 3): angles from the heading, radians; the conspecific slot order."""
 
 from __future__ import annotations
 
 import numpy as np
 
+from .._jit import njit
 from ..config.schema import AmpullaryConfig, KnollenorganConfig, MormyromastConfig
 
 
@@ -49,3 +50,22 @@ def sensor_frame(xy: np.ndarray, heading: np.ndarray, angles: np.ndarray, radius
     world = heading[..., None] + angles
     normals = np.stack([np.cos(world), np.sin(world)], axis=-1)
     return xy[..., None, :] + radius * normals, normals
+
+
+@njit(cache=True)
+def slot_agent(agent: int, slot: int) -> int:
+    """The agent heard in conspecific ``slot`` of ``agent``: the other agents in id order, ``agent`` skipped.
+
+    The one definition of the slot order (SPEC 3.3) for Knollenorgans, their
+    size channels and the critic's agent-centric state.
+    """
+    return slot if slot < agent else slot + 1
+
+
+def conspecific_slots(n: int) -> np.ndarray:
+    """int64[n, n - 1]: row a lists the agents in a's conspecific slots (:func:`slot_agent`).
+
+    >>> conspecific_slots(3).tolist()
+    [[1, 2], [0, 2], [0, 1]]
+    """
+    return np.array([[slot_agent(a, j) for j in range(n - 1)] for a in range(n)], dtype=np.int64).reshape(n, n - 1)

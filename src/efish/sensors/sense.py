@@ -9,13 +9,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from .config import EfishConfig, compose
-from .physics.fast import fast_raw
-from .physics.plan import EffectPlan, build_plan
-from .physics.reference import RawReadings, reference_raw
-from .physics.snapshot import Snapshot, SnapshotBatch
-from .sensors.noise import apply_noise
-from .sensors.normalize import binarize, knollen_size_channel, log_normalize
+from ..config import EfishConfig, compose
+from ..physics.fast import fast_raw
+from ..physics.geometry import conspecific_slots
+from ..physics.plan import EffectPlan, Scene, build_plan
+from ..physics.readings import RawReadings
+from ..physics.reference import reference_raw
+from ..physics.snapshot import Snapshot, SnapshotBatch
+from .noise import apply_noise
+from .normalize import binarize, knollen_size_channel, log_normalize
 
 _DEFAULT_CFG: EfishConfig | None = None
 
@@ -42,8 +44,7 @@ def normalise(raw: RawReadings, agent_size: np.ndarray, plan: EffectPlan) -> dic
     n = agent_size.shape[1]
     dtype = raw.mormyromast.dtype
     spikes = binarize(raw.knollenorgan, plan.knollen_threshold)
-    others = np.array([[j for j in range(n) if j != a] for a in range(n)], dtype=np.int64).reshape(n, n - 1)
-    slot_sizes = agent_size[:, others].astype(dtype)                          # [B, N, N-1]
+    slot_sizes = agent_size[:, conspecific_slots(n)].astype(dtype)                          # [B, N, N-1]
     out = {
         "mormyromast": log_normalize(raw.mormyromast, *plan.morm_range),
         "ampullary": log_normalize(raw.ampullary, *plan.amp_range),
@@ -88,7 +89,7 @@ def sense(snapshot: Snapshot, cfg: EfishConfig | None = None, *, tolerance: floa
     ((2, 36), (2, 1, 12))
     """
     cfg = cfg or default_config()
-    plan = build_plan(cfg, tolerance=tolerance, n_pellets=snapshot.n_pellets,
-                      any_emitter=bool(snapshot.agent_emitting.any()), n_agents=snapshot.n_agents)
-    out = sense_batch(snapshot.as_batch(), plan, reference=reference, rng=rng, return_raw=return_raw)
+    batch = snapshot.as_batch()
+    plan = build_plan(cfg, Scene.of_batch(batch), tolerance=tolerance)
+    out = sense_batch(batch, plan, reference=reference, rng=rng, return_raw=return_raw)
     return {k: v[0] for k, v in out.items()}

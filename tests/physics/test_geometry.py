@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from efish.config.schema import AmpullaryConfig, KnollenorganConfig, MormyromastConfig
-from efish.sensors import ampullary_angles, knollenorgan_angles, mormyromast_angles, sensor_frame
+from efish.physics import ampullary_angles, knollenorgan_angles, mormyromast_angles, sensor_frame
 
 
 def test_mormyromast_layout():

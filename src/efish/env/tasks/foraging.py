@@ -1,11 +1,18 @@
-"""Foraging and homing rewards (SPEC 7), per component so training can log each one."""
+"""Foraging (SPEC 7): pellets are worth eating, approaching them is shaped, bites and collisions cost.
+
+The episode ends only at the time limit. Rewards come from one numba pass over
+the batch (:func:`foraging_kernel`), per component so that training logs each.
+"""
 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
-from ..config.schema import EnvConfig
+from ..._jit import njit
+from ...config.schema import EnvConfig
+from ..geometry import nearest_pellet
+from ..state import EnvState
+from .base import StepEvents, Task
 
 FORAGING_PARTS = ("food", "shaping", "bitten", "bite", "collision", "effort", "total")
 # Indices into the ``coef`` array of the foraging kernel.
@@ -61,15 +68,21 @@ def foraging_rewards(cfg: EnvConfig, ate: np.ndarray, d_prev: np.ndarray, d_now:
     return dict(zip(FORAGING_PARTS, out))
 
 
-def homing_rewards(cfg: EnvConfig, d_prev: np.ndarray, d_now: np.ndarray, perimeter: np.ndarray,
-                   is_target: np.ndarray) -> dict[str, np.ndarray]:
-    """Homing reward components (SPEC 7), float64[B, N]; the target itself gets 0."""
-    home = d_now <= cfg.homing_radius_cm
-    homer = ~is_target[None, :]
-    parts = {
-        "home": cfg.homing_reward_home * home * homer,
-        "shaping": cfg.homing_shaping * (d_prev - d_now) / perimeter[:, None] * homer,
-        "step": -cfg.homing_step_cost * homer * np.ones_like(d_now),
-    }
-    parts["total"] = sum(parts.values())
-    return parts
+class Foraging(Task):
+    """Eat pellets; the shaping follows the nearest live pellet."""
+
+    name = "foraging"
+    reward_parts = FORAGING_PARTS
+    distance_key = "d_food_cm"
+
+    def __init__(self, cfg, n_agents):
+        super().__init__(cfg, n_agents)
+        self.coef = foraging_coefficients(cfg.env)
+
+    def goal_distance(self, state: EnvState, out: np.ndarray) -> None:
+        nearest_pellet(state.xy, state.pellet_xy, state.alive, out)
+
+    def rewards(self, state: EnvState, events: StepEvents, d_prev: np.ndarray) -> dict[str, np.ndarray]:
+        return foraging_rewards(self.cfg.env, events.ate, d_prev, state.goal_dist, state.width, state.height,
+                                events.penalty_bitten, events.bit, events.collided, events.move, events.turn,
+                                self.coef)

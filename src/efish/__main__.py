@@ -1,0 +1,7 @@
+"""``python -m efish``: the same command as ``efish``."""
+
+import sys
+
+from .cli import main
+
+sys.exit(main())
