@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import pytest
 
-from efish.config import ConfigError, EfishConfig, compose, to_yaml, validate
+from efish.config import ConfigError, EfishConfig, compose, config_dir, to_yaml, validate
+from efish.config.schema import (
+    ArenaConfig, AssayConfig, BenchConfig, EnvConfig, PhysicsConfig, ScaleConfig, SensorsConfig, TrainConfig,
+)
 
 from ..conftest import cfg_with
 
@@ -114,3 +117,45 @@ def test_validate_names_the_key_of_a_mutated_tree(default_cfg):
 
 def test_config_error_is_a_value_error():
     assert issubclass(ConfigError, ValueError)
+
+
+GROUPS = {"physics": PhysicsConfig, "sensors": SensorsConfig, "arena": ArenaConfig, "env": EnvConfig,
+          "train": TrainConfig, "assay": AssayConfig, "bench": BenchConfig, "scale": ScaleConfig}
+
+
+def _leaves(node, prefix=""):
+    """(dotted key, value) of every leaf of a YAML mapping, interpolations unresolved."""
+    for key, value in node.items():
+        if isinstance(value, dict):
+            yield from _leaves(value, f"{prefix}{key}.")
+        else:
+            yield f"{prefix}{key}", value
+
+
+def _default(group: str, key: str):
+    obj = GROUPS[group]()
+    for part in key.split("."):
+        obj = getattr(obj, part)
+    return obj
+
+
+@pytest.mark.parametrize("path", sorted(config_dir().glob("*/*.yaml")), ids=lambda p: f"{p.parent.name}/{p.name}")
+def test_yaml_files_set_only_what_differs_from_the_schema(path):
+    """One copy of every default: the dataclasses hold them; a YAML value equal to its default is a second copy.
+
+    An assay file's own ``assay:`` block is exempt: it describes that assay in
+    full (episodes, seed, policy) so a reader sees the protocol in one place.
+    """
+    import yaml
+
+    data = yaml.safe_load(path.read_text()) or {}
+    data.pop("defaults", None)
+    package_global = path.read_text().startswith("# @package _global_")
+    roots = data.items() if package_global else [(path.parent.name, data)]
+    for group, node in roots:
+        if path.parent.name == "assay" and group == "assay":
+            continue
+        for key, value in _leaves(node):
+            if isinstance(value, str) and value.startswith("${"):
+                continue  # an interpolation: read from another group, not a copy
+            assert value != _default(group, key), f"{path.name}: {group}.{key}={value!r} repeats the schema default"

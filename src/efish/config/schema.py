@@ -274,7 +274,7 @@ class ScaleConfig:
     chunk: int = param(50, "foraging BPTT chunk (train.chunk reads it)", lo=1)
     epochs: int = param(15, "PPO epochs per update (train.epochs reads it)", lo=1)
     train_steps: int = param(240_000, "foraging env steps per seed", lo=1)
-    homing_steps: int = param(120_000, "homing env steps", lo=1)
+    homing_steps: int = param(160_000, "homing env steps", lo=1)
     homing_rollout_steps: int = param(800, "steps per homing rollout", lo=1)
     max_episodes: int = param(8, "cap on the episodes per assay condition (SPEC 11 counts at paper scale)", lo=1)
     selection_episodes: int = param(8, "patchy4 episodes per seed for seed selection (SPEC 10)", lo=1)
