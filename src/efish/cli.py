@@ -138,30 +138,14 @@ def _assay(args, cfg, started) -> None:
 
 
 def _select(args, cfg, started) -> None:
-    import re
-
-    import pandas as pd
-
-    from .analysis.selection import rank_seeds, seed_statistics
+    from .analysis.selection import select_seed
     from .io import atomic_path, write_run_metadata, write_text_atomic
 
-    frames = []
-    for path in args.episodes:
-        m = re.search(r"seed_(\d+)", str(path))
-        if not m:
-            raise ValueError(f"cannot tell the seed of {path}: put it under a folder named seed_<n>")
-        try:
-            frames.append(pd.read_parquet(path).assign(seed=int(m.group(1))))
-        except OSError:
-            raise
-        except Exception as exc:  # pyarrow raises its own types for files that are not Parquet
-            raise ValueError(f"cannot read {path} as an episodes table: {type(exc).__name__}") from None
-    table = rank_seeds(seed_statistics(pd.concat(frames, ignore_index=True)))
+    table, chosen = select_seed(args.episodes)
     if table["fallback"].any():
         print("efish: warning: no seed has a positive median intercept; ranked all seeds (fallback)", file=sys.stderr)
     with atomic_path(args.out / "ranking.parquet") as tmp:
         table.to_parquet(tmp, index=False)
-    chosen = int(table.loc[table["selected"], "seed"].iloc[0])
     write_text_atomic(args.out / "selected_seed.txt", f"{chosen}\n")
     write_run_metadata(args.out, to_yaml(cfg), started, {"episodes": [str(p) for p in args.episodes]})
     print(table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))

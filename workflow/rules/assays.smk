@@ -16,9 +16,10 @@ rule assay:
         "results/{scale}/benchmarks/assays/{assay}.tsv"
     params:
         overrides=ARGS,
+        out=folder_of("steps"),
     threads: 1
     conda:
         "../envs/efish.yaml"
     shell:
         "efish assay assay={wildcards.assay} scale={wildcards.scale} {params.overrides} --policy {input.policy} "
-        "--out results/{wildcards.scale}/assays/{wildcards.assay} > {log} 2>&1"
+        "--out {params.out} > {log} 2>&1"

@@ -10,11 +10,12 @@ rule bench_physics:
         "results/{scale}/benchmarks/bench_physics.tsv"
     params:
         overrides=ARGS,
+        out=folder_of(0),
     threads: 1
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish bench physics scale={wildcards.scale} {params.overrides} --out results/{wildcards.scale}/bench > {log} 2>&1"
+        "efish bench physics scale={wildcards.scale} {params.overrides} --out {params.out} > {log} 2>&1"
 
 
 rule bench_accuracy:
@@ -27,11 +28,12 @@ rule bench_accuracy:
         "results/{scale}/benchmarks/bench_accuracy.tsv"
     params:
         overrides=ARGS,
+        out=folder_of("table"),
     threads: 1
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish bench accuracy scale={wildcards.scale} {params.overrides} --out results/{wildcards.scale}/bench > {log} 2>&1"
+        "efish bench accuracy scale={wildcards.scale} {params.overrides} --out {params.out} > {log} 2>&1"
 
 
 rule figure_bench_accuracy:

@@ -43,6 +43,12 @@ wildcard_constraints:
     assay=r"[A-Za-z0-9_\-]+",
 
 
+def folder_of(name, up=0):
+    """A params function: the folder of output ``name`` (a name or an index), or the folder ``up`` levels
+    above it. It is what efish's ``--out`` takes, so no rule repeats an output path."""
+    return lambda wildcards, output: str(Path(output[name]).parents[up])
+
+
 def panel_inputs(panel):
     """Every table a panel reads, at this scale (the same expansion efish figure uses)."""
     return [str(path) for paths in input_paths(panel, Path(f"results/{SCALE}"), len(SEEDS)).values() for path in paths]

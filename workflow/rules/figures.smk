@@ -18,13 +18,14 @@ rule panel:
     params:
         overrides=ARGS,
         caption=lambda w: panel_of(w).caption,
+        out=folder_of("png", up=1),
     wildcard_constraints:
         figure="fig[0-9]+|supp",
     conda:
         "../envs/efish.yaml"
     shell:
         "efish figure {wildcards.figure}/{wildcards.panel} scale={wildcards.scale} {params.overrides} "
-        "--results results/{wildcards.scale} --out figures/{wildcards.scale} > {log} 2>&1"
+        "--results results/{wildcards.scale} --out {params.out} > {log} 2>&1"
 
 
 rule figure_page:
@@ -39,10 +40,11 @@ rule figure_page:
         "results/{scale}/benchmarks/figures/{figure}.tsv"
     params:
         overrides=ARGS,
+        out=folder_of("png"),
     wildcard_constraints:
         figure="fig[0-9]+|supp",
     conda:
         "../envs/efish.yaml"
     shell:
         "efish figure {wildcards.figure} scale={wildcards.scale} {params.overrides} "
-        "--results results/{wildcards.scale} --out figures/{wildcards.scale} > {log} 2>&1"
+        "--results results/{wildcards.scale} --out {params.out} > {log} 2>&1"

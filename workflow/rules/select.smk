@@ -15,12 +15,13 @@ rule evaluate_seed:
         "results/{scale}/benchmarks/selection/seed_{seed}.tsv"
     params:
         overrides=ARGS,
+        out=folder_of(0),
     threads: 1
     conda:
         "../envs/efish.yaml"
     shell:
         "efish assay assay=selection scale={wildcards.scale} {params.overrides} --policy {input} "
-        "--out results/{wildcards.scale}/selection/seed_{wildcards.seed} > {log} 2>&1"
+        "--out {params.out} > {log} 2>&1"
 
 
 checkpoint select_seed:
@@ -35,7 +36,8 @@ checkpoint select_seed:
         "results/{scale}/benchmarks/select_seed.tsv"
     params:
         overrides=ARGS,
+        out=folder_of("ranking"),
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish select scale={wildcards.scale} {params.overrides} --episodes {input} --out results/{wildcards.scale}/analysis/selection > {log} 2>&1"
+        "efish select scale={wildcards.scale} {params.overrides} --episodes {input} --out {params.out} > {log} 2>&1"

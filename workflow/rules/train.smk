@@ -1,4 +1,5 @@
-# Training: every foraging seed of the scale, and the homing policy. efish train
+# Training: every foraging seed of the scale, and the homing policy
+# (config/policy/homing.yaml composes its task, arenas and training). efish train
 # checkpoints beside the declared output and writes final.pt atomically at the
 # end, so a killed job is rerun and resumes from its last checkpoint.
 
@@ -13,12 +14,13 @@ rule train:
         "results/{scale}/benchmarks/train/seed_{seed}.tsv"
     params:
         overrides=ARGS,
+        out=folder_of("final"),
     threads: 1
     conda:
         "../envs/efish.yaml"
     shell:
         "efish train scale={wildcards.scale} train.seed={wildcards.seed} train.threads={threads} "
-        "{params.overrides} --out results/{wildcards.scale}/train/seed_{wildcards.seed} > {log} 2>&1"
+        "{params.overrides} --out {params.out} > {log} 2>&1"
 
 
 rule train_homing:
@@ -31,9 +33,10 @@ rule train_homing:
         "results/{scale}/benchmarks/train/homing.tsv"
     params:
         overrides=ARGS,
+        out=folder_of("final"),
     threads: 1
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish train scale={wildcards.scale} train=homing env=homing arena=homing_train train.threads={threads} "
-        "{params.overrides} --out results/{wildcards.scale}/train/homing > {log} 2>&1"
+        "efish train scale={wildcards.scale} policy=homing train.threads={threads} "
+        "{params.overrides} --out {params.out} > {log} 2>&1"

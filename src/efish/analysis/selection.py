@@ -9,6 +9,10 @@ rank sum wins, ties going to more food.
 
 from __future__ import annotations
 
+import re
+from pathlib import Path
+from typing import Iterable
+
 import numpy as np
 import pandas as pd
 
@@ -63,3 +67,32 @@ def rank_seeds(stats: pd.DataFrame) -> pd.DataFrame:
     table["selected"] = False
     table.loc[0, "selected"] = True
     return table[list(RANKING_COLUMNS)]
+
+
+def read_seed_episodes(paths: Iterable[str | Path]) -> pd.DataFrame:
+    """The episodes tables of several seeds as one frame with a ``seed`` column.
+
+    Each path must lie under a folder named ``seed_<n>`` (how the pipeline
+    writes them); a path without one, or a file that is not Parquet, is one
+    clear ``ValueError``.
+    """
+    frames = []
+    for path in paths:
+        m = re.search(r"seed_(\d+)", str(path))
+        if not m:
+            raise ValueError(f"cannot tell the seed of {path}: put it under a folder named seed_<n>")
+        try:
+            frames.append(pd.read_parquet(path).assign(seed=int(m.group(1))))
+        except OSError:
+            raise
+        except Exception as exc:  # pyarrow raises its own types for files that are not Parquet
+            raise ValueError(f"cannot read {path} as an episodes table: {type(exc).__name__}") from None
+    if not frames:
+        raise ValueError("no episodes tables given")
+    return pd.concat(frames, ignore_index=True)
+
+
+def select_seed(paths: Iterable[str | Path]) -> tuple[pd.DataFrame, int]:
+    """SPEC 10 on the episodes tables at ``paths``: the full ranking table and the chosen seed."""
+    table = rank_seeds(seed_statistics(read_seed_episodes(paths)))
+    return table, int(table.loc[table["selected"], "seed"].iloc[0])
