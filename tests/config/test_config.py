@@ -9,7 +9,7 @@ from efish.config.schema import (
     ArenaConfig, AssayConfig, BenchConfig, EnvConfig, PhysicsConfig, ScaleConfig, SensorsConfig, TrainConfig,
 )
 
-from ..conftest import cfg_with
+from ..helpers import cfg_with
 
 
 def test_default_config_matches_the_spec(default_cfg):

@@ -16,6 +16,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+try:
+    from ..helpers import random_actions
+except ImportError:  # run as a script to regenerate the record
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    from helpers import random_actions
+
 DATA = Path(__file__).resolve().parents[1] / "data" / "trajectories.npz"
 STEPS, ENVS = 40, 3
 # Short episodes so that autoreset happens inside the record.
@@ -47,12 +53,11 @@ def record(overrides: list[str]) -> dict[str, np.ndarray]:
     out["obs_sum"].append(obs.astype(np.float64).sum(-1))
     out["obs_abs"].append(np.abs(obs.astype(np.float64)).sum(-1))
     for _ in range(STEPS):
-        a = np.concatenate([rng.normal(size=(ENVS, env.n, 2)), rng.integers(0, 2, (ENVS, env.n, 2))], axis=-1)
-        obs, reward, term, trunc, info = env.step(a)
+        obs, reward, term, trunc, info = env.step(random_actions(rng, ENVS, env.n))
         out["obs_sum"].append(obs.astype(np.float64).sum(-1))
         out["obs_abs"].append(np.abs(obs.astype(np.float64)).sum(-1))
-        out["xy"].append(env.xy.copy())
-        out["heading"].append(env.heading.copy())
+        out["xy"].append(env.state.xy.copy())
+        out["heading"].append(env.state.heading.copy())
         for k, v in (("reward", reward), ("terminated", term), ("truncated", trunc)):
             out[k].append(np.asarray(v))
         for k in ("ate", "bit", "eod", "collided"):

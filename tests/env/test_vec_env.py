@@ -9,18 +9,7 @@ from efish.config import ConfigError, compose
 from efish.env import VecEnv, parallel_env
 from efish.env.observe import observation_slices
 
-BIG = 40.0  # raw action whose sigmoid / tanh is 1 to double precision
-
-
-def make(*overrides, num_envs=1, seed=0):
-    return VecEnv(compose(list(overrides)), num_envs=num_envs, seed=seed)
-
-
-def actions(env, move=-BIG, turn=0.0, eod=0, bite=0):
-    a = np.zeros((env.num_envs, env.n, 4))
-    a[..., 0], a[..., 1], a[..., 2], a[..., 3] = move, turn, eod, bite
-    return a
-
+from ..helpers import BIG, actions, make_env as make
 
 def place_pellets(env, xy):
     env.state.alive[:] = False

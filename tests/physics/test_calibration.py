@@ -24,7 +24,7 @@ import pytest
 
 from efish import Snapshot, sense
 
-from ..conftest import cfg_with
+from ..helpers import cfg_with
 
 ARENA = 400.0
 OBSERVER = (100.0, 200.0)

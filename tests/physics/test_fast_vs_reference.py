@@ -16,7 +16,7 @@ from efish.physics.fast import fast_raw
 from efish.physics.reference import reference_raw
 from efish.sensors.sense import normalise
 
-from ..conftest import cfg_with, plan_for, random_snapshot
+from ..helpers import cfg_with, plan_for, random_snapshot
 
 RAW = ("mormyromast", "ampullary", "knollenorgan")
 NORM = ("mormyromast", "ampullary", "knollenorgan", "knollen_size")

@@ -18,7 +18,7 @@ from efish.physics.fast import fast_raw
 from efish.physics.reference import reference_raw
 from efish.sensors.sense import normalise
 
-from ..conftest import RECEPTORS, assert_valid_readings, cfg_with, plan_for, random_snapshot
+from ..helpers import RECEPTORS, assert_valid_readings, cfg_with, plan_for, random_snapshot
 
 
 def check(snapshot: Snapshot, cfg=None, *, reference_too: bool = True, rng=None) -> dict:

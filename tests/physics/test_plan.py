@@ -12,7 +12,7 @@ from efish.env.vec_env import scene_of
 from efish.physics import Scene, build_plan
 from efish.sensors.sense import sense_batch
 
-from ..conftest import RECEPTORS, cfg_with, random_snapshot
+from ..helpers import RECEPTORS, cfg_with, random_snapshot
 
 
 @pytest.fixture(scope="module")

@@ -25,7 +25,7 @@ import pytest
 from efish import Snapshot, sense
 from efish.physics import ampullary_angles, knollenorgan_angles, mormyromast_angles
 
-from ..conftest import cfg_with, random_snapshot
+from ..helpers import cfg_with, random_snapshot
 
 RAW = ("mormyromast", "ampullary", "knollenorgan")
 

@@ -6,9 +6,9 @@ import pandas as pd
 import pytest
 
 from efish.cli import main
+from efish.config import compose
 from efish.rl.policy import load_policy
 from efish.rl.train import train
-from efish.config import compose
 from efish.rollout.assay import run_assay
 
 TINY_TRAIN = ["arena=collective", "env.n_agents=2", "env.episode_steps=20", "train.hidden=8", "train.num_envs=2",

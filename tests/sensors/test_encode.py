@@ -16,7 +16,7 @@ from efish.sensors.encode import electric_width, encode_readings
 from efish.sensors.noise import apply_noise, noise_uniforms
 from efish.sensors.sense import normalise
 
-from ..conftest import cfg_with
+from ..helpers import cfg_with
 
 
 def assert_bits(got: np.ndarray, want: np.ndarray) -> None:

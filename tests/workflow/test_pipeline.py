@@ -45,6 +45,7 @@ def declared_outputs(work: Path) -> list[str]:
     return [line.split("\t")[0] for line in result.stdout.splitlines()[1:] if line.strip()]
 
 
+@pytest.mark.slow
 def test_every_declared_output_exists(smoke_run):
     outputs = declared_outputs(smoke_run)
     for part in ("train/seed_1/final.pt", "train/seed_2/final.pt", "train/homing/final.pt",
@@ -56,6 +57,7 @@ def test_every_declared_output_exists(smoke_run):
     assert not missing
 
 
+@pytest.mark.slow
 def test_every_table_matches_its_schema(smoke_run):
     tables = list((smoke_run / "results/smoke").glob("**/*.parquet"))
     checked = 0
@@ -71,6 +73,7 @@ def test_every_table_matches_its_schema(smoke_run):
     assert chosen == int(ranking.loc[ranking["selected"], "seed"].iloc[0])
 
 
+@pytest.mark.slow
 def test_every_output_folder_has_config_and_provenance(smoke_run):
     folders = {p.parent for p in (smoke_run / "results/smoke").glob("**/*.parquet")}
     folders |= {p.parent for p in (smoke_run / "figures/smoke").glob("*/*.png")}
@@ -82,6 +85,7 @@ def test_every_output_folder_has_config_and_provenance(smoke_run):
         assert "name: smoke" in (folder / "config.yaml").read_text(), folder
 
 
+@pytest.mark.slow
 def test_the_recorded_command_reproduces_an_assay(smoke_run, tmp_path):
     """The provenance's command, rerun elsewhere, gives the same config and the same tables."""
     folder = smoke_run / "results/smoke/assays/patchy4"
@@ -128,6 +132,7 @@ def smoke_env(work: Path) -> dict:
     return {**os.environ, "EFISH_CONFIG_DIR": str(work / "config")}
 
 
+@pytest.mark.slow
 def test_accuracy_table_matches_its_schema(smoke_run):
     df = pd.read_parquet(smoke_run / "results/smoke/bench/bench_accuracy.parquet")
     assert list(df.columns) == list(COLUMNS)
@@ -137,12 +142,14 @@ def test_accuracy_table_matches_its_schema(smoke_run):
     assert (df["us_per_agent_step"] > 0).all()
 
 
+@pytest.mark.slow
 def test_physics_bench_reports_its_numbers(smoke_run):
     r = json.loads((smoke_run / "results/smoke/bench/bench_physics.json").read_text())
     assert r["fast_agent_steps_per_s"] > 0 and r["reference_agent_steps_per_s"] > 0
     assert r["max_abs_diff_normalised"] <= 1e-6
 
 
+@pytest.mark.slow
 def test_scale_is_recorded_in_the_resolved_config(smoke_run):
     assert "name: smoke" in (smoke_run / "results/smoke/bench/config.yaml").read_text()
 
@@ -159,6 +166,7 @@ def test_workflow_lints_clean():
     assert "Congratulations, your workflow is in a good condition" in result.stdout + result.stderr
 
 
+@pytest.mark.slow
 def test_report_renders_after_a_smoke_run(smoke_run):
     result = subprocess.run(["snakemake", "--cores", "1", "--config", "scale=smoke", "--report", "report.html",
                              "--directory", str(smoke_run), "--snakefile", str(smoke_run / "Snakefile")],
@@ -167,6 +175,7 @@ def test_report_renders_after_a_smoke_run(smoke_run):
     assert (smoke_run / "report.html").stat().st_size > 10_000
 
 
+@pytest.mark.slow
 def test_a_killed_training_job_resumes_from_its_checkpoint(tmp_path):
     """Interrupt the pipeline mid-training; the rerun continues the seed from its last checkpoint."""
     for name in ("Snakefile", "workflow", "config"):

@@ -1,0 +1,94 @@
+"""Shared helpers of the analysis modules: column checks, keys, angles, per-agent rates, step pairs.
+
+Private: the analysis modules import these so that a check or a pairing is
+written once.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+import numpy as np
+import pandas as pd
+
+#: ms per simulation step: dt = 1/83 s (SPEC "Units"), i.e. 12.048 ms.
+STEP_MS = 1000.0 / 83.0
+#: Steps per second, the factor from an EOD probability per step to a rate in Hz.
+RATE_HZ = 83.0
+
+EPISODE = ["condition", "episode"]
+AGENT_EPISODE = ["condition", "episode", "agent"]
+
+
+def require(df: pd.DataFrame, columns: Iterable[str], table: str = "table") -> None:
+    """Raise ValueError with one line naming the columns ``df`` lacks."""
+    if missing := sorted(set(columns) - set(df.columns)):
+        raise ValueError(f"{table} lacks columns {missing}")
+
+
+def wrap(a: np.ndarray) -> np.ndarray:
+    """Angles wrapped to [-pi, pi)."""
+    return (np.asarray(a, dtype=np.float64) + np.pi) % (2 * np.pi) - np.pi
+
+
+def nan_frame(reason: str, **values) -> pd.DataFrame:
+    """One row of NaN statistics that says why (the degenerate-input contract of every analysis)."""
+    return pd.DataFrame([{**values, "reason": reason}])
+
+
+def or_nan_row(frame: pd.DataFrame, reason: str) -> pd.DataFrame:
+    """``frame``, or, when it has no rows, one NaN row with its columns and a ``reason``: nothing to summarise."""
+    if len(frame):
+        return frame
+    return nan_frame(reason).reindex(columns=list(dict.fromkeys([*frame.columns, "reason"])))
+
+
+def eod_rate(steps: pd.DataFrame, window: int = 20, rate_hz: float = RATE_HZ) -> np.ndarray:
+    """Centred rolling mean of ``eod`` over ``window`` steps x ``rate_hz`` per agent-episode (SPEC 12), in Hz.
+
+    Only full windows count, so the first and last ``window // 2`` steps of an
+    episode are NaN rather than biased by a shorter window. Row-aligned with ``steps``.
+    """
+    require(steps, [*AGENT_EPISODE, "t", "eod"], "steps table")
+    order = steps[[*AGENT_EPISODE, "t", "eod"]].reset_index(drop=True).sort_values([*AGENT_EPISODE, "t"])
+    rate = (order["eod"].astype(np.float64).groupby([order[k] for k in AGENT_EPISODE], sort=False)
+            .transform(lambda s: s.rolling(window, center=True, min_periods=window).mean()))
+    return rate.sort_index().to_numpy() * rate_hz
+
+
+def pairs(steps: pd.DataFrame, columns: Iterable[str] = ()) -> pd.DataFrame:
+    """Every ordered pair (agent, partner) of distinct agents at every step, with their distance.
+
+    Columns: condition, episode, t, agent, partner, ``x_cm``, ``y_cm`` and the extra
+    ``columns`` of both agents (the partner's suffixed ``_p``), ``dx_cm``, ``dy_cm``
+    (partner minus agent) and ``dist_cm``; rows sorted by pair, then t.
+    """
+    keep = list(dict.fromkeys([*EPISODE, "t", "agent", "x_cm", "y_cm", *columns]))
+    require(steps, keep, "steps table")
+    left = steps[keep]
+    out = left.merge(left.rename(columns={c: f"{c}_p" for c in keep if c not in (*EPISODE, "t")}),
+                     on=[*EPISODE, "t"])
+    out = out[out["agent"] != out["agent_p"]].rename(columns={"agent_p": "partner"})
+    out["dx_cm"] = out["x_cm_p"].to_numpy(np.float64) - out["x_cm"].to_numpy(np.float64)
+    out["dy_cm"] = out["y_cm_p"].to_numpy(np.float64) - out["y_cm"].to_numpy(np.float64)
+    out["dist_cm"] = np.hypot(out["dx_cm"], out["dy_cm"])
+    return out.sort_values([*EPISODE, "agent", "partner", "t"]).reset_index(drop=True)
+
+
+def run_ids(flag: np.ndarray, same_series: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Id of each maximal run of True ``flag`` over consecutive ``t`` within one series; -1 off runs.
+
+    ``same_series[i]`` says row i continues the series of row i - 1 (rows sorted by series, t).
+    """
+    flag = np.asarray(flag, dtype=bool)
+    prev_flag = np.r_[False, flag[:-1]]
+    contiguous = np.asarray(same_series, dtype=bool) & (np.diff(np.asarray(t), prepend=np.nan) == 1)
+    start = flag & ~(prev_flag & contiguous)
+    ids = np.cumsum(start) - 1
+    return np.where(flag, ids, -1)
+
+
+def agent_sizes(steps: pd.DataFrame) -> pd.Series:
+    """Size per (condition, episode, agent): sizes are fixed within an agent-episode."""
+    require(steps, [*AGENT_EPISODE, "size"], "steps table")
+    return steps.groupby(AGENT_EPISODE, sort=True)["size"].first()

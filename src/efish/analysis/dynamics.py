@@ -1,0 +1,227 @@
+"""Hidden-state dynamics (SPEC 12; Fig 6): dimensionality, decoding, shared dimensions (PLSC), power.
+
+Functions on matrices take a T x D array ``h`` (time x units, e.g. one
+agent-episode of the ``hidden`` table, see :func:`hidden_matrix`). Scalar
+results are NaN when the input cannot give an answer; :func:`degenerate_reason`
+says why, and the table functions put it in a ``reason`` column.
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pandas as pd
+from scipy import signal
+from sklearn.dummy import DummyRegressor
+from sklearn.linear_model import LinearRegression
+from sklearn.metrics import r2_score
+from sklearn.model_selection import GroupKFold, cross_val_predict
+
+from ._tables import AGENT_EPISODE, RATE_HZ, require
+
+SUBSAMPLE_FRACTIONS = (0.05, 0.15, 0.25, 0.5, 0.75, 1.0)
+
+
+def hidden_matrix(hidden: pd.DataFrame) -> np.ndarray:
+    """The ``h_0 .. h_{D-1}`` columns of a hidden-state frame as a T x D float64 array, rows in t order."""
+    units = sorted((c for c in hidden.columns if c.startswith("h_") and c[2:].isdigit()), key=lambda c: int(c[2:]))
+    if not units:
+        raise ValueError("hidden table has no h_<i> columns")
+    frame = hidden.sort_values("t") if "t" in hidden else hidden
+    return frame[units].to_numpy(np.float64)
+
+
+def degenerate_reason(h: np.ndarray, min_rows: int = 2) -> str:
+    """Why ``h`` cannot give a dimensionality or power ('' when it can): too few rows, non-finite, no variance."""
+    h = np.asarray(h, dtype=np.float64)
+    if h.ndim != 2 or h.shape[0] < min_rows or h.shape[1] == 0:
+        return f"need a T x D matrix with T >= {min_rows} and D >= 1, got shape {h.shape}"
+    if not np.all(np.isfinite(h)):
+        return "non-finite values"
+    if not np.any(np.ptp(h, axis=0) > 0):
+        return "no unit varies"
+    return ""
+
+
+def pca_variances(h: np.ndarray) -> np.ndarray:
+    """Normalised PCA variances (sum 1, descending) of the rows of ``h``; empty when ``h`` is degenerate."""
+    if degenerate_reason(h):
+        return np.empty(0)
+    s = np.linalg.svd(np.asarray(h, dtype=np.float64) - np.mean(h, axis=0), compute_uv=False)
+    var = s ** 2
+    return var / var.sum()
+
+
+def effective_dimensionality(h: np.ndarray) -> float:
+    """D_eff = 1 / sum(lambda_i^2) of the normalised PCA variances lambda_i (SPEC 12); NaN when degenerate.
+
+    >>> rng = np.random.default_rng(0)
+    >>> round(effective_dimensionality(np.outer(rng.normal(size=50), [1.0, 2.0, 3.0])), 6)
+    1.0
+    """
+    lam = pca_variances(h)
+    return float(1.0 / np.sum(lam ** 2)) if lam.size else np.nan
+
+
+def pcs_for_variance(h: np.ndarray, fraction: float = 0.9) -> float:
+    """Fewest principal components whose variances add up to ``fraction`` (SPEC 12: 90%); NaN if degenerate."""
+    lam = pca_variances(h)
+    if not lam.size:
+        return np.nan
+    # the tolerance keeps fraction = 1 reachable despite rounding in the cumulative sum
+    return float(np.searchsorted(np.cumsum(lam), fraction - 1e-12) + 1)
+
+
+def subsample_units(h: np.ndarray, fractions=SUBSAMPLE_FRACTIONS, draws: int = 30,
+                    rng: np.random.Generator | int | None = None) -> pd.DataFrame:
+    """D_eff of random subsets of units (SPEC 12: fractions .05 .15 .25 .5 .75 1, 30 draws each), Fig 6C.
+
+    Each draw keeps round(fraction x D) units (at least 1) without replacement.
+    Columns: fraction, n_units, draw, d_eff, reason.
+    """
+    rng = np.random.default_rng(rng)
+    h = np.asarray(h, dtype=np.float64)
+    rows = []
+    for f in fractions:
+        k = max(1, round(f * h.shape[1]))
+        for d in range(draws):
+            sub = h[:, rng.choice(h.shape[1], size=k, replace=False)]
+            rows.append({"fraction": f, "n_units": k, "draw": d, "d_eff": effective_dimensionality(sub),
+                         "reason": degenerate_reason(sub)})
+    return pd.DataFrame(rows)
+
+
+def wideband_power(h: np.ndarray, window: int = 20, overlap: int = 10, fs: float = RATE_HZ) -> float:
+    """Mean spectrogram power over units, windows and frequencies (SPEC 12: 20-step windows, 10 overlap).
+
+    scipy.signal.spectrogram with its defaults otherwise (Tukey window,
+    constant detrend, power spectral density at sampling rate ``fs``); NaN when
+    ``h`` is degenerate or shorter than one window.
+    """
+    if degenerate_reason(h, min_rows=window):
+        return np.nan
+    _, _, sxx = signal.spectrogram(np.asarray(h, dtype=np.float64).T, fs=fs, nperseg=window, noverlap=overlap)
+    return float(sxx.mean())
+
+
+def dynamics_table(hidden: pd.DataFrame, fraction: float = 0.9, window: int = 20, overlap: int = 10) -> pd.DataFrame:
+    """Per agent-episode of a hidden table: D_eff, PCs for ``fraction`` of the variance, wideband power, reason."""
+    require(hidden, [*AGENT_EPISODE, "t"], "hidden table")
+    rows = []
+    for keys, sub in hidden.groupby(AGENT_EPISODE, sort=True):
+        h = hidden_matrix(sub)
+        rows.append({**dict(zip(AGENT_EPISODE, keys, strict=True)), "n_steps": len(h),
+                     "d_eff": effective_dimensionality(h), "pcs_for_variance": pcs_for_variance(h, fraction),
+                     "wideband_power": wideband_power(h, window, overlap), "reason": degenerate_reason(h)})
+    return pd.DataFrame(rows, columns=[*AGENT_EPISODE, "n_steps", "d_eff", "pcs_for_variance", "wideband_power",
+                                       "reason"])
+
+
+def decode(x: np.ndarray, y: np.ndarray, groups: np.ndarray, circular: bool = False, folds: int = 5) -> dict:
+    """Cross-validated linear readout of ``y`` from ``x`` (SPEC 12 "Decoding"), folds grouped by episode.
+
+    OLS (sklearn LinearRegression) under GroupKFold(``folds``) over ``groups``
+    (so no episode is in both train and test), pooled out-of-fold predictions;
+    ``r2`` is their R^2, ``baseline_r2`` that of predicting each test fold with
+    its training mean (DummyRegressor), ``score`` = r2 - baseline_r2. A
+    circular ``y`` (radians) is decoded as (cos y, sin y) and R^2 averaged over
+    both. Rows with a non-finite value are dropped (``n`` counts the rest);
+    fewer than 2 groups or a constant target give NaN with a reason.
+    """
+    x = np.asarray(x, dtype=np.float64)
+    x = x[:, None] if x.ndim == 1 else x
+    y, groups = np.asarray(y, dtype=np.float64), np.asarray(groups)
+    if not len(x) == len(y) == len(groups):
+        raise ValueError(f"x, y and groups differ in length: {len(x)}, {len(y)}, {len(groups)}")
+    target = np.column_stack([np.cos(y), np.sin(y)]) if circular else y[:, None]
+    keep = np.all(np.isfinite(x), axis=1) & np.all(np.isfinite(target), axis=1)
+    x, target, groups = x[keep], target[keep], groups[keep]
+    n_groups = len(np.unique(groups))
+    out = {"r2": np.nan, "baseline_r2": np.nan, "score": np.nan, "n": int(keep.sum()), "n_groups": n_groups,
+           "folds": min(folds, n_groups), "reason": ""}
+    if n_groups < 2:
+        return {**out, "reason": f"fewer than 2 groups (episodes) with finite rows ({n_groups})"}
+    if not np.any(np.ptp(target, axis=0) > 0):
+        return {**out, "reason": "constant target"}
+    cv = GroupKFold(n_splits=out["folds"])
+    pred = cross_val_predict(LinearRegression(), x, target, groups=groups, cv=cv).reshape(target.shape)
+    base = cross_val_predict(DummyRegressor(strategy="mean"), x, target, groups=groups, cv=cv).reshape(target.shape)
+    varies = np.ptp(target, axis=0) > 0  # a circular target fixed in cos or sin has no R^2 in that component
+    r2, r2_base = r2_score(target[:, varies], pred[:, varies]), r2_score(target[:, varies], base[:, varies])
+    return {**out, "r2": float(r2), "baseline_r2": float(r2_base), "score": float(r2 - r2_base)}
+
+
+def _zscore(h: np.ndarray) -> np.ndarray:
+    """Columns centred and scaled to unit variance; constant columns become 0 (they carry no covariance)."""
+    h = np.asarray(h, dtype=np.float64)
+    sd = h.std(axis=0)
+    return np.divide(h - h.mean(axis=0), sd, out=np.zeros_like(h), where=sd > 0)
+
+
+def _plsc_spectrum(za: np.ndarray, zb: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """Top-k singular values of the cross-covariance and the correlations of the paired component scores."""
+    u, s, vt = np.linalg.svd(za.T @ zb / (len(za) - 1), full_matrices=False)
+    a, b = za @ u[:, :k], zb @ vt[:k].T
+    sa, sb = a.std(axis=0), b.std(axis=0)
+    r = np.divide((a * b).mean(axis=0) - a.mean(axis=0) * b.mean(axis=0), sa * sb, out=np.zeros(k),
+                  where=(sa > 0) & (sb > 0))
+    return s[:k], r
+
+
+def plsc(h_a: np.ndarray, h_b: np.ndarray, shifts: int = 30, rng: np.random.Generator | int | None = None,
+         percentile: float = 97.5) -> dict:
+    """Partial least squares correlation of two agents' hidden states with a circular-shift null (SPEC 12).
+
+    Both T x D matrices are z-scored per unit; the SVD of their
+    cross-covariance gives singular values and paired components. The null
+    recomputes both after circularly shifting ``h_b`` in time by ``shifts``
+    random offsets in [T/10, 9T/10] (which keeps each series' autocorrelation and
+    breaks their alignment). Component i is significant when its singular value
+    and its score correlation both exceed the ``percentile`` of the i-th null
+    values; ``n_significant`` counts significant components up to the first that is not.
+    """
+    h_a, h_b = np.asarray(h_a, dtype=np.float64), np.asarray(h_b, dtype=np.float64)
+    if len(h_a) != len(h_b):
+        raise ValueError(f"h_a and h_b differ in length: {len(h_a)} vs {len(h_b)}")
+    k = min(h_a.shape[-1], h_b.shape[-1])
+    # at least 10 steps, so that the null's shifts (T/10 to 9T/10) are never 0
+    reason = degenerate_reason(h_a, 10) or degenerate_reason(h_b, 10)
+    if reason:
+        nan = np.full(k, np.nan)
+        return {"singular_values": nan, "correlations": nan, "null_singular_values": nan,
+                "null_correlations": nan, "n_significant": np.nan, "reason": reason}
+    za, zb = _zscore(h_a), _zscore(h_b)
+    s, r = _plsc_spectrum(za, zb, k)
+    rng = np.random.default_rng(rng)
+    t = len(za)
+    null = [_plsc_spectrum(za, np.roll(zb, rng.integers(t // 10, t - t // 10 + 1), axis=0), k) for _ in range(shifts)]
+    s_null = np.percentile([n[0] for n in null], percentile, axis=0)
+    r_null = np.percentile([n[1] for n in null], percentile, axis=0)
+    passed = (s > s_null) & (r > r_null)
+    n_sig = int(np.argmin(passed)) if not passed.all() else k
+    return {"singular_values": s, "correlations": r, "null_singular_values": s_null, "null_correlations": r_null,
+            "n_significant": n_sig, "reason": ""}
+
+
+def plsc_by_distance(h_a: np.ndarray, h_b: np.ndarray, dist_cm: np.ndarray, edges_cm=(10.0, 100.0),
+                     shifts: int = 30, rng: np.random.Generator | int | None = None) -> pd.DataFrame:
+    """:func:`plsc` on the steps whose inter-agent distance falls in each bin (SPEC 12: <= 10, 10-100, > 100 cm).
+
+    The steps of a bin are taken in time order and the null shifts them as one
+    series. One row per bin: ``lo_cm``, ``hi_cm`` (bins are (lo, hi], the first
+    from 0 inclusive), ``n_steps``, ``n_significant``, the largest singular
+    value ``s_1`` and a reason (e.g. a bin with fewer than 10 steps).
+    """
+    dist = np.asarray(dist_cm, dtype=np.float64)
+    if not len(dist) == len(h_a) == len(h_b):
+        raise ValueError(f"h_a, h_b and dist_cm differ in length: {len(h_a)}, {len(h_b)}, {len(dist)}")
+    rng = np.random.default_rng(rng)
+    bounds = [-np.inf, *edges_cm, np.inf]
+    rows = []
+    for lo, hi in itertools.pairwise(bounds):
+        keep = (dist > lo) & (dist <= hi)
+        res = plsc(np.asarray(h_a)[keep], np.asarray(h_b)[keep], shifts, rng)
+        rows.append({"lo_cm": max(lo, 0.0), "hi_cm": hi, "n_steps": int(keep.sum()),
+                     "n_significant": res["n_significant"], "s_1": res["singular_values"][0], "reason": res["reason"]})
+    return pd.DataFrame(rows)

@@ -1,0 +1,213 @@
+"""EOD signalling (SPEC 12 "IDI", "EOD rate"): inter-discharge intervals, power laws, EOD rate vs context.
+
+The EOD rate of a step is the 20-step centred rolling mean of ``eod`` times
+83 Hz, computed per agent-episode. Rates are binned against distances,
+aligned on events, or compared between agents close to each other.
+"""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ._tables import AGENT_EPISODE, EPISODE, RATE_HZ, STEP_MS, agent_sizes, eod_rate, nan_frame, pairs, require
+
+#: Distance column and default binning range (cm) per ``to`` of :func:`eod_rate_by_distance` (SPEC 12).
+DISTANCE_RANGES_CM = {"agent": (0.0, 150.0), "food": (0.0, 10.0), "wall": (0.0, 10.0)}
+#: Event columns :func:`peri_event_rate` aligns on: eating, biting, being bitten.
+EVENTS = ("ate", "bit", "was_bitten")
+
+
+def idis(steps: pd.DataFrame, step_ms: float = STEP_MS) -> pd.DataFrame:
+    """One row per inter-discharge interval: the step difference of consecutive EODs of an agent-episode.
+
+    Columns: condition, episode, agent, t (step of the later discharge),
+    ``idi_steps`` and ``idi_ms`` = ``idi_steps`` x ``step_ms`` (12.048 ms, SPEC 12).
+    """
+    require(steps, [*AGENT_EPISODE, "t", "eod"], "steps table")
+    fired = steps.loc[steps["eod"].astype(bool), [*AGENT_EPISODE, "t"]].sort_values([*AGENT_EPISODE, "t"])
+    fired["idi_steps"] = fired.groupby(AGENT_EPISODE, sort=False)["t"].diff()
+    out = fired.dropna(subset=["idi_steps"]).astype({"idi_steps": np.int64})
+    out["idi_ms"] = out["idi_steps"] * step_ms
+    return out.reset_index(drop=True)
+
+
+def idi_histogram(idi_ms, bins: int = 50, lo_ms: float = 10.0, hi_ms: float = 3000.0) -> pd.DataFrame:
+    """Counts and density of IDIs on ``bins`` log-spaced bins over [``lo_ms``, ``hi_ms``] (SPEC 12).
+
+    The density is per ms, so histograms with different bin widths compare.
+    """
+    x = np.asarray(idi_ms, dtype=np.float64)
+    edges = np.geomspace(lo_ms, hi_ms, bins + 1)
+    counts, _ = np.histogram(x[np.isfinite(x)], bins=edges)
+    total = counts.sum()
+    density = counts / (total * np.diff(edges)) if total else np.full(bins, np.nan)
+    return pd.DataFrame({"bin_lo_ms": edges[:-1], "bin_hi_ms": edges[1:], "count": counts, "density": density})
+
+
+def fit_power_law(idi_ms, xmin_ms: float = 12.0, min_n: int = 10) -> dict:
+    """Power-law fit of IDIs >= ``xmin_ms`` with ``powerlaw.Fit``, compared with lognormal and exponential.
+
+    Returns ``alpha``, ``xmin``, ``n`` (IDIs in the fit), and for each
+    alternative the normalised loglikelihood ratio ``R_<alt>`` (> 0 favours the
+    power law) and its ``p``. ``reason`` is empty for a clean fit; it names why
+    the numbers are NaN (fewer than ``min_n`` IDIs, no spread), or lists
+    powerlaw's warnings, e.g. an alternative whose maximum-likelihood fit did
+    not converge (its R is kept: it compares with the best fit powerlaw found).
+    """
+    x = np.asarray(idi_ms, dtype=np.float64)
+    x = x[np.isfinite(x) & (x > 0)]  # powerlaw would drop (and warn about) non-positive values itself
+    n = int(np.sum(x >= xmin_ms))
+    out = {"alpha": np.nan, "xmin": float(xmin_ms), "n": n, "R_lognormal": np.nan, "p_lognormal": np.nan,
+           "R_exponential": np.nan, "p_exponential": np.nan, "reason": ""}
+    if n < min_n:
+        return {**out, "reason": f"fewer than {min_n} IDIs >= xmin ({n})"}
+    if np.ptp(x[x >= xmin_ms]) == 0:
+        return {**out, "reason": "all IDIs >= xmin are equal"}
+    import powerlaw  # imported here: it loads matplotlib, which the rest of the analyses do not need
+
+    # powerlaw warns about the data (e.g. integer-valued IDIs fitted as continuous) and
+    # about alternatives whose optimiser did not converge (e.g. lognormal on pure
+    # power-law data, whose likelihood keeps rising as mu -> -inf); both are reported
+    # in ``reason``, not hidden and not raised.
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        fit = powerlaw.Fit(x, xmin=xmin_ms, verbose=False)
+        out["alpha"] = float(fit.power_law.alpha)
+        for alt in ("lognormal", "exponential"):
+            r, p = fit.distribution_compare("power_law", alt, normalized_ratio=True)
+            out[f"R_{alt}"], out[f"p_{alt}"] = float(r), float(p)
+    notes = list(dict.fromkeys(f"powerlaw: {w.message}" for w in caught))
+    return {**out, "reason": "; ".join(notes)}
+
+
+def load_real_idis(path: str | Path | None) -> pd.DataFrame:
+    """Real-fish IDIs (ms) from a user-supplied CSV or Parquet file with an ``idi_ms`` column.
+
+    The recordings are not public (SPEC D), so ``path`` is unset by default
+    (config ``analysis.real_fish_idis``); the result is then one NaN row whose
+    ``reason`` says so, and a fit or a panel reports it instead of failing.
+    """
+    if path is None or str(path) == "":
+        return nan_frame("no real-fish IDI table given (analysis.real_fish_idis is unset)", idi_ms=np.nan)
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"real-fish IDI table {path} does not exist")
+    readers = {".csv": pd.read_csv, ".parquet": pd.read_parquet, ".pq": pd.read_parquet}
+    if path.suffix.lower() not in readers:
+        raise ValueError(f"real-fish IDI table {path} is neither .csv nor .parquet")
+    df = readers[path.suffix.lower()](path)
+    require(df, ["idi_ms"], f"real-fish IDI table {path}")
+    return df.assign(idi_ms=df["idi_ms"].astype(np.float64), reason="")
+
+
+BIN_COLUMNS = ["condition", "to", "bin", "bin_lo_cm", "bin_hi_cm", "bin_mid_cm", "n", "mean_hz", "sem_hz", "reason"]
+
+
+def _binned_mean_sem(values: np.ndarray, x: np.ndarray, edges: np.ndarray, min_samples: int) -> pd.DataFrame:
+    ok = np.isfinite(values) & np.isfinite(x) & (x >= edges[0]) & (x <= edges[-1])
+    idx = np.clip(np.searchsorted(edges, x[ok], side="right") - 1, 0, len(edges) - 2)  # x = hi goes in the last
+    table = pd.DataFrame({"bin": idx, "v": values[ok]}).groupby("bin")["v"].agg(["size", "mean", "sem"])
+    table = table[table["size"] >= min_samples]
+    b = table.index.to_numpy()
+    return pd.DataFrame({"bin": b, "bin_lo_cm": edges[b], "bin_hi_cm": edges[b + 1],
+                         "bin_mid_cm": (edges[b] + edges[b + 1]) / 2, "n": table["size"].to_numpy(),
+                         "mean_hz": table["mean"].to_numpy(), "sem_hz": table["sem"].to_numpy(), "reason": ""})
+
+
+def eod_rate_by_distance(steps: pd.DataFrame, to: str, bins: int = 15, range_cm: tuple[float, float] | None = None,
+                         min_samples: int = 5, window: int = 20, rate_hz: float = RATE_HZ) -> pd.DataFrame:
+    """Mean +- SEM EOD rate (Hz) in ``bins`` equal distance bins to the nearest ``to`` (agent, food or wall).
+
+    Ranges default to SPEC 12: 0-150 cm for agents, 0-10 cm for food and wall.
+    Samples are steps (every agent-step with a full rate window), per condition;
+    bins with fewer than ``min_samples`` steps are dropped. A condition with no
+    bin left gets one NaN row with a reason.
+    """
+    if to not in DISTANCE_RANGES_CM:
+        raise ValueError(f"to must be one of {sorted(DISTANCE_RANGES_CM)}, got {to!r}")
+    column = f"dist_{to}_cm"
+    require(steps, ["condition", column], "steps table")
+    edges = np.linspace(*(range_cm or DISTANCE_RANGES_CM[to]), bins + 1)
+    rate, dist = eod_rate(steps, window, rate_hz), steps[column].to_numpy(np.float64)
+    parts = []
+    for cond, idx in steps.groupby("condition", sort=True).indices.items():
+        table = _binned_mean_sem(rate[idx], dist[idx], edges, min_samples)
+        if table.empty:
+            table = nan_frame(f"no distance bin has {min_samples} or more samples", n=0)
+        parts.append(table.assign(condition=cond, to=to))
+    if not parts:
+        parts = [nan_frame("empty steps table", to=to, n=0)]
+    return pd.concat(parts, ignore_index=True).reindex(columns=BIN_COLUMNS)
+
+
+def _event_triggered(rate: np.ndarray, events: np.ndarray, lags: np.ndarray) -> np.ndarray:
+    """Mean rate at t + lag over the events of one agent-episode; NaN where no event has a rate there."""
+    idx = events[:, None] + lags[None, :]
+    inside = (idx >= 0) & (idx < rate.size)
+    vals = np.where(inside, rate[np.clip(idx, 0, rate.size - 1)], np.nan)
+    return pd.DataFrame(vals).mean().to_numpy()  # pandas: a lag no event reaches is NaN, without a warning
+
+
+def peri_event_rate(steps: pd.DataFrame, event: str, window: int = 100, min_events: int = 3,
+                    rate_window: int = 20, rate_hz: float = RATE_HZ) -> pd.DataFrame:
+    """Mean +- SEM EOD rate (Hz) from ``window`` steps before to ``window`` after an ``event`` (SPEC 12).
+
+    ``event`` is a boolean steps column: ``ate``, ``bit`` or ``was_bitten``.
+    Each agent-episode with at least ``min_events`` events contributes its mean
+    over events at every lag; the mean and SEM are across those agent-episodes
+    (``n_agents``), per condition. Without any such agent-episode the condition
+    gets one NaN row with a reason.
+    """
+    if event not in EVENTS:
+        raise ValueError(f"event must be one of {list(EVENTS)}, got {event!r}")
+    require(steps, [*AGENT_EPISODE, "t", event], "steps table")
+    lags = np.arange(-window, window + 1)
+    rate = eod_rate(steps, rate_window, rate_hz)
+    frame = steps[[*AGENT_EPISODE, "t", event]].assign(rate=rate).sort_values([*AGENT_EPISODE, "t"])
+    parts = []
+    for cond, sub in frame.groupby("condition", sort=True):
+        curves = [_event_triggered(g["rate"].to_numpy(), np.flatnonzero(g[event].to_numpy(bool)), lags)
+                  for _, g in sub.groupby(["episode", "agent"], sort=True) if g[event].sum() >= min_events]
+        if not curves:
+            parts.append(nan_frame(f"no agent-episode has {min_events} or more '{event}' events",
+                                   condition=cond, lag=np.nan, n_agents=0, mean_hz=np.nan, sem_hz=np.nan))
+            continue
+        c = pd.DataFrame(np.vstack(curves))  # agent-episodes x lags; pandas skips NaN without warning
+        parts.append(pd.DataFrame({"condition": cond, "lag": lags, "n_agents": c.count().to_numpy(),
+                                   "mean_hz": c.mean().to_numpy(), "sem_hz": c.sem().to_numpy(), "reason": ""}))
+    if not parts:
+        return nan_frame("empty steps table", condition=np.nan, lag=np.nan, n_agents=0, mean_hz=np.nan,
+                         sem_hz=np.nan)
+    out = pd.concat(parts, ignore_index=True).assign(event=event)
+    out["lag_ms"] = out["lag"] * STEP_MS
+    return out
+
+
+def rate_advantage_vs_size(steps: pd.DataFrame, within_cm: float = 10.0, window: int = 20,
+                           rate_hz: float = RATE_HZ) -> pd.DataFrame:
+    """Per pair of agents and episode: EOD-rate advantage vs size advantage while within ``within_cm`` (Fig 3P).
+
+    One row per unordered pair (``agent`` < ``partner``): ``size_advantage`` =
+    size(agent) - size(partner), ``rate_advantage_hz`` = mean over the steps
+    with the pair within ``within_cm`` of rate(agent) - rate(partner), and
+    ``n_steps``. Pairs never that close are left out. Correlate the two with
+    :func:`efish.analysis.stats.spearman`.
+    """
+    require(steps, [*AGENT_EPISODE, "t", "eod", "size", "x_cm", "y_cm"], "steps table")
+    frame = steps.assign(rate=eod_rate(steps, window, rate_hz))
+    p = pairs(frame, ["rate"])
+    p = p[(p["agent"] < p["partner"]) & (p["dist_cm"] <= within_cm)]
+    p = p.assign(diff=p["rate"] - p["rate_p"]).dropna(subset=["diff"])
+    if p.empty:
+        return nan_frame(f"no pair of agents within {within_cm} cm", condition=np.nan, episode=np.nan,
+                         agent=np.nan, partner=np.nan, size_advantage=np.nan, rate_advantage_hz=np.nan, n_steps=0)
+    out = p.groupby([*EPISODE, "agent", "partner"], sort=True)["diff"].agg(["mean", "size"]).reset_index()
+    sizes = agent_sizes(steps)
+    own = sizes.reindex(pd.MultiIndex.from_frame(out[AGENT_EPISODE])).to_numpy()
+    other = sizes.reindex(pd.MultiIndex.from_frame(out[[*EPISODE, "partner"]])).to_numpy()
+    return pd.DataFrame({**{k: out[k] for k in [*EPISODE, "agent", "partner"]}, "size_advantage": own - other,
+                         "rate_advantage_hz": out["mean"], "n_steps": out["size"], "reason": ""})

@@ -1,0 +1,181 @@
+"""Statistical tests as tidy rows (SPEC 12 "Tests"): Dunnett vs control, Mann-Whitney, Wilcoxon, Spearman.
+
+Every function returns one row per comparison with the columns of
+``STAT_COLUMNS``: which ``test``, the ``group`` and the ``control`` it is
+compared with, ``n`` and ``n_control``, an ``effect`` in the value's units
+(``effect_kind`` says which), the test ``statistic``, ``p``, ``stars`` and a
+``reason`` that is empty unless the row is NaN. A figure or a claim reads the
+row; it never recomputes the test. The tests themselves are scipy's.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pandas as pd
+from scipy import stats as sps
+
+from ._tables import require
+
+STAT_COLUMNS = ["test", "group", "control", "n", "n_control", "effect", "effect_kind", "statistic", "p", "stars",
+                "reason"]
+#: (threshold, stars), the p <= threshold convention of GraphPad Prism and statannotations.
+STAR_LEVELS = ((1e-4, "****"), (1e-3, "***"), (1e-2, "**"), (5e-2, "*"))
+
+
+def stars(p: float) -> str:
+    """Significance stars: ``****`` p <= 1e-4, ``***`` <= 1e-3, ``**`` <= .01, ``*`` <= .05, else ``ns``; NaN ``n/a``.
+
+    >>> [stars(p) for p in (0.2, 0.05, 0.01, 1e-3, 1e-4, float("nan"))]
+    ['ns', '*', '**', '***', '****', 'n/a']
+    """
+    if not np.isfinite(p):
+        return "n/a"
+    return next((s for level, s in STAR_LEVELS if p <= level), "ns")
+
+
+def _row(test: str, group, control, n: int, n_control: int, effect: float, effect_kind: str,
+         statistic: float = np.nan, p: float = np.nan, reason: str = "") -> dict:
+    return {"test": test, "group": group, "control": control, "n": int(n), "n_control": int(n_control),
+            "effect": float(effect), "effect_kind": effect_kind, "statistic": float(statistic), "p": float(p),
+            "stars": stars(float(p)), "reason": reason}
+
+
+def _finite(values) -> np.ndarray:
+    v = np.asarray(values, dtype=np.float64)
+    return v[np.isfinite(v)]
+
+
+def _samples(df: pd.DataFrame, value: str, group: str, control) -> dict:
+    """Finite values per group, the control first; ValueError if the control is missing."""
+    if control not in set(df[group]):
+        raise ValueError(f"control {control!r} is not a value of column {group!r}")
+    # every group is listed, even one without a finite value: its row then says so
+    samples = {g: _finite(s[value]) for g, s in df.groupby(group, sort=True)}
+    return {control: samples.pop(control), **samples}
+
+
+def _single_nan_row(test: str, control, effect_kind: str, reason: str) -> pd.DataFrame:
+    """The whole answer when there is nothing to compare: one NaN row that says why."""
+    return pd.DataFrame([_row(test, np.nan, control, 0, 0, np.nan, effect_kind, reason=reason)], columns=STAT_COLUMNS)
+
+
+def _too_small(sizes: dict, minimum: int = 2) -> str:
+    small = [g for g, n in sizes.items() if n < minimum]
+    return f"fewer than {minimum} finite values in group(s) {small}" if small else ""
+
+
+def dunnett_vs_control(df: pd.DataFrame, value: str, group: str, control, rng: int = 0) -> pd.DataFrame:
+    """Dunnett's many-to-one test of every group's mean ``value`` against ``control`` (scipy.stats.dunnett).
+
+    The effect is the difference of means (group minus control). ``rng`` seeds
+    scipy's quasi-Monte Carlo p-values so a rerun gives the same p. All rows
+    are NaN with a reason when a group has fewer than two values or no group varies.
+    """
+    require(df, [value, group], "table")
+    if df.empty:
+        return _single_nan_row("dunnett", control, "mean difference", "empty table")
+    samples = _samples(df, value, group, control)
+    ctrl, others = samples.pop(control), samples
+    if not others:
+        return _single_nan_row("dunnett", control, "mean difference", "no group besides the control")
+    reason = _too_small({control: ctrl.size, **{g: s.size for g, s in others.items()}})
+    if not reason and all(np.ptp(s) == 0 for s in (ctrl, *others.values())):
+        reason = "no within-group variance"
+    diffs = {g: (s.mean() - ctrl.mean() if s.size and ctrl.size else np.nan) for g, s in others.items()}
+    if reason:
+        return pd.DataFrame([_row("dunnett", g, control, s.size, ctrl.size, diffs[g], "mean difference",
+                                  reason=reason) for g, s in others.items()], columns=STAT_COLUMNS)
+    with warnings.catch_warnings():
+        # scipy checks each sample's variance for cancellation and flags an exactly constant
+        # sample with a non-zero mean; Dunnett uses the pooled variance, which is exact here.
+        warnings.filterwarnings("ignore", message="Precision loss occurred", category=RuntimeWarning)
+        res = sps.dunnett(*others.values(), control=ctrl, rng=np.random.default_rng(rng))
+    return pd.DataFrame([_row("dunnett", g, control, s.size, ctrl.size, diffs[g], "mean difference",
+                              res.statistic[i], res.pvalue[i]) for i, (g, s) in enumerate(others.items())],
+                        columns=STAT_COLUMNS)
+
+
+def mann_whitney(df: pd.DataFrame, value: str, group: str, control) -> pd.DataFrame:
+    """Two-sided Mann-Whitney U test of every group against ``control`` (scipy.stats.mannwhitneyu).
+
+    The effect is the difference of medians (group minus control); the
+    statistic is U of the group. No correction for multiple comparisons.
+    """
+    require(df, [value, group], "table")
+    if df.empty:
+        return _single_nan_row("mann-whitney", control, "median difference", "empty table")
+    samples = _samples(df, value, group, control)
+    ctrl = samples.pop(control)
+    if not samples:
+        return _single_nan_row("mann-whitney", control, "median difference", "no group besides the control")
+    rows = []
+    for g, s in samples.items():
+        effect = np.median(s) - np.median(ctrl) if s.size and ctrl.size else np.nan
+        reason = _too_small({control: ctrl.size, g: s.size}, 1)
+        if not reason and np.ptp(np.r_[s, ctrl]) == 0:
+            reason = "all values identical"
+        if reason:
+            rows.append(_row("mann-whitney", g, control, s.size, ctrl.size, effect, "median difference",
+                             reason=reason))
+            continue
+        res = sps.mannwhitneyu(s, ctrl, alternative="two-sided")
+        rows.append(_row("mann-whitney", g, control, s.size, ctrl.size, effect, "median difference",
+                         res.statistic, res.pvalue))
+    return pd.DataFrame(rows, columns=STAT_COLUMNS)
+
+
+def wilcoxon_paired(df: pd.DataFrame, value: str, group: str, control, pair_on: str | list[str]) -> pd.DataFrame:
+    """Two-sided Wilcoxon signed-rank test of every group against ``control``, paired by ``pair_on``.
+
+    Rows of ``df`` with equal ``pair_on`` keys (e.g. ``episode``) are matched; a
+    key missing from either group is left out, and ``n`` counts the pairs. The
+    effect is the median of the paired differences (group minus control).
+    """
+    keys = [pair_on] if isinstance(pair_on, str) else list(pair_on)
+    require(df, [*keys, value, group], "table")
+    if df.empty:
+        return _single_nan_row("wilcoxon", control, "median paired difference", "empty table")
+    if control not in set(df[group]):
+        raise ValueError(f"control {control!r} is not a value of column {group!r}")
+    if df.duplicated([*keys, group]).any():
+        raise ValueError(f"more than one row per ({', '.join(keys)}, {group}): pairs are ambiguous")
+    wide = df.pivot(index=keys, columns=group, values=value)
+    if len(wide.columns) < 2:
+        return _single_nan_row("wilcoxon", control, "median paired difference", "no group besides the control")
+    rows = []
+    for g in [c for c in wide.columns if c != control]:
+        both = wide[[g, control]].astype(np.float64).dropna()
+        d = (both[g] - both[control]).to_numpy()
+        effect = float(np.median(d)) if d.size else np.nan
+        reason = "no complete pairs" if d.size == 0 else ("all paired differences are zero" if np.all(d == 0) else "")
+        if reason:
+            rows.append(_row("wilcoxon", g, control, d.size, d.size, effect, "median paired difference",
+                             reason=reason))
+            continue
+        res = sps.wilcoxon(both[g], both[control], alternative="two-sided")
+        rows.append(_row("wilcoxon", g, control, d.size, d.size, effect, "median paired difference",
+                         res.statistic, res.pvalue))
+    return pd.DataFrame(rows, columns=STAT_COLUMNS)
+
+
+def spearman(df: pd.DataFrame, x: str, y: str, by: str | None = None) -> pd.DataFrame:
+    """Spearman rank correlation of ``y`` with ``x`` (scipy.stats.spearmanr), one row per value of ``by``.
+
+    The effect and the statistic are rho; ``group`` is the ``by`` value (or
+    ``"all"``) and ``control`` names the x column.
+    """
+    require(df, [x, y] + ([by] if by else []), "table")
+    rows = []
+    for g, sub in (list(df.groupby(by, sort=True)) if by else []) or [("all", df)]:
+        xy = sub[[x, y]].astype(np.float64).dropna().to_numpy()
+        reason = "fewer than 3 finite pairs" if len(xy) < 3 else ""
+        if not reason and (np.ptp(xy[:, 0]) == 0 or np.ptp(xy[:, 1]) == 0):
+            reason = f"{x if np.ptp(xy[:, 0]) == 0 else y} is constant"
+        if reason:
+            rows.append(_row("spearman", g, x, len(xy), len(xy), np.nan, "rho", reason=reason))
+            continue
+        res = sps.spearmanr(xy[:, 0], xy[:, 1])
+        rows.append(_row("spearman", g, x, len(xy), len(xy), res.statistic, "rho", res.statistic, res.pvalue))
+    return pd.DataFrame(rows, columns=STAT_COLUMNS)

@@ -1,0 +1,174 @@
+"""Hidden-state analyses with planted answers; every analysis module imports without numba or torch."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from efish.analysis.dynamics import (
+    decode,
+    degenerate_reason,
+    dynamics_table,
+    effective_dimensionality,
+    hidden_matrix,
+    pca_variances,
+    pcs_for_variance,
+    plsc,
+    plsc_by_distance,
+    subsample_units,
+    wideband_power,
+)
+
+MODULES = ["signalling", "behaviour", "interactions", "homing", "stats", "dynamics"]
+
+
+def test_analysis_modules_load_neither_numba_nor_torch():
+    # one fresh interpreter for all: if their union loads neither, none of them does
+    code = (f"import sys; import {', '.join('efish.analysis.' + m for m in MODULES)}; "
+            "bad = [m for m in ('numba', 'torch') if m in sys.modules]; assert not bad, bad")
+    subprocess.run([sys.executable, "-c", code], check=True)
+
+
+def test_effective_dimensionality_of_isotropic_and_rank_one_data():
+    rng = np.random.default_rng(0)
+    assert effective_dimensionality(rng.normal(size=(4000, 8))) == pytest.approx(8.0, rel=0.02)
+    rank1 = np.outer(rng.normal(size=200), rng.normal(size=16))
+    assert effective_dimensionality(rank1) == pytest.approx(1.0)
+    assert pcs_for_variance(rank1) == 1.0
+
+
+def test_pcs_for_variance_on_a_known_spectrum():
+    rng = np.random.default_rng(0)
+    z = rng.normal(size=(500, 4))
+    z = np.linalg.qr(z - z.mean(axis=0))[0]          # orthonormal columns with zero mean
+    h = z * np.sqrt([0.6, 0.25, 0.1, 0.05])          # variances 0.6, 0.25, 0.1, 0.05 of the total
+    np.testing.assert_allclose(pca_variances(h), [0.6, 0.25, 0.1, 0.05], atol=1e-9)
+    assert [pcs_for_variance(h, f) for f in (0.5, 0.85, 0.9, 0.95, 1.0)] == [1, 2, 3, 3, 4]
+
+
+@pytest.mark.parametrize(("h", "reason"), [(np.ones((50, 4)), "no unit varies"),
+                                           (np.c_[np.arange(50.0), np.full(50, np.nan)], "non-finite values"),
+                                           (np.ones((1, 4)), "need a T x D matrix")])
+def test_degenerate_hidden_states_give_nan_with_a_reason(h, reason):
+    assert degenerate_reason(h).startswith(reason)
+    assert np.isnan(effective_dimensionality(h)) and np.isnan(pcs_for_variance(h)) and np.isnan(wideband_power(h))
+
+
+def test_constant_units_do_not_count():
+    rng = np.random.default_rng(0)
+    h = np.c_[rng.normal(size=(3000, 3)), np.full((3000, 5), 2.0)]
+    assert effective_dimensionality(h) == pytest.approx(3.0, rel=0.03)
+
+
+def test_subsample_units():
+    rng = np.random.default_rng(0)
+    h = rng.normal(size=(300, 40))
+    out = subsample_units(h, draws=4, rng=1)
+    assert out.groupby("fraction")["n_units"].first().tolist() == [2, 6, 10, 20, 30, 40]
+    assert len(out) == 24 and out.groupby("fraction")["d_eff"].mean().is_monotonic_increasing
+    full = out[out["fraction"] == 1.0]["d_eff"]
+    assert full.to_numpy() == pytest.approx(np.full(4, effective_dimensionality(h)))
+    assert out.equals(subsample_units(h, draws=4, rng=1))
+
+
+def planted(rng, n_episodes=12, per=50, d=20):
+    x = rng.normal(size=(n_episodes * per, d))
+    return x, np.repeat(np.arange(n_episodes), per)
+
+
+def test_decode_recovers_a_planted_readout():
+    rng = np.random.default_rng(0)
+    x, groups = planted(rng)
+    out = decode(x, x @ rng.normal(size=20) + 0.01 * rng.normal(size=len(x)), groups)
+    assert out["score"] == pytest.approx(1.0, abs=0.05) and out["r2"] > 0.99 and out["folds"] == 5
+    angle = np.arctan2(x[:, 1], x[:, 0])  # a circular target; its cos and sin are not linear in x,
+    circ = decode(np.c_[x, np.cos(angle), np.sin(angle)], angle, groups, circular=True)  # unless given
+    assert circ["score"] == pytest.approx(1.0, abs=0.05)
+
+
+def test_decode_is_about_zero_on_noise_and_on_unrelated_episode_constants():
+    rng = np.random.default_rng(0)
+    x, groups = planted(rng)
+    noise = decode(x, rng.normal(size=len(x)), groups)
+    episode_constant = decode(x, rng.normal(size=12)[groups], groups)  # leaks only if folds split episodes
+    assert abs(noise["score"]) < 0.15 and abs(episode_constant["score"]) < 0.15
+
+
+def test_decode_degenerate_inputs():
+    rng = np.random.default_rng(0)
+    x, groups = planted(rng, n_episodes=3)
+    one = decode(x, x[:, 0], np.zeros(len(x)))
+    assert np.isnan(one["score"]) and one["reason"].startswith("fewer than 2 groups")
+    assert decode(x, np.ones(len(x)), groups)["reason"] == "constant target"
+    nan_y = x[:, 0].copy()
+    nan_y[:10] = np.nan
+    out = decode(x, nan_y, groups)
+    assert out["n"] == len(x) - 10 and out["folds"] == 3 and out["score"] > 0.9
+    all_nan = decode(np.c_[x, np.full(len(x), np.nan)], x[:, 0], groups)
+    assert np.isnan(all_nan["score"]) and all_nan["n"] == 0 and all_nan["reason"] != ""
+    with pytest.raises(ValueError, match="differ in length"):
+        decode(x, x[:-1, 0], groups)
+
+
+def test_plsc_finds_planted_shared_dimensions():
+    rng = np.random.default_rng(0)
+    t, k = 800, 3
+    shared = rng.normal(size=(t, k))
+    h_a = shared @ rng.normal(size=(k, 16)) + rng.normal(size=(t, 16))
+    h_b = shared @ rng.normal(size=(k, 12)) + rng.normal(size=(t, 12))
+    out = plsc(h_a, h_b, rng=0)
+    assert out["n_significant"] == k and len(out["singular_values"]) == 12
+    assert np.all(np.diff(out["singular_values"]) <= 0)
+    independent = plsc(rng.normal(size=(t, 16)), rng.normal(size=(t, 12)), rng=0)
+    assert independent["n_significant"] == 0
+
+
+def test_plsc_degenerate():
+    rng = np.random.default_rng(0)
+    out = plsc(np.ones((100, 4)), rng.normal(size=(100, 4)), rng=0)
+    assert np.isnan(out["n_significant"]) and out["reason"] == "no unit varies"
+    with pytest.raises(ValueError, match="differ in length"):
+        plsc(rng.normal(size=(100, 4)), rng.normal(size=(90, 4)))
+
+
+def test_wideband_power_scales_with_variance():
+    rng = np.random.default_rng(0)
+    h = rng.normal(size=(400, 6))
+    assert wideband_power(2 * h) == pytest.approx(4 * wideband_power(h))
+    assert np.isnan(wideband_power(h[:19]))  # shorter than one 20-step window
+
+
+def test_hidden_frame_helpers():
+    rng = np.random.default_rng(0)
+    rows = []
+    for agent in (0, 1):
+        h = rng.normal(size=(60, 12)) if agent == 0 else np.zeros((60, 12))
+        frame = pd.DataFrame(h, columns=[f"h_{i}" for i in range(12)])
+        rows.append(frame.assign(condition="c", episode=0, t=np.arange(60), agent=agent))
+    hidden = pd.concat(rows, ignore_index=True)
+    shuffled = hidden.sample(frac=1.0, random_state=0)
+    mine = hidden_matrix(shuffled[shuffled["agent"] == 0])
+    np.testing.assert_array_equal(mine, hidden[hidden["agent"] == 0][[f"h_{i}" for i in range(12)]].to_numpy())
+    table = dynamics_table(shuffled).set_index("agent")
+    assert table.loc[0, "d_eff"] > 5 and table.loc[0, "reason"] == ""
+    assert np.isnan(table.loc[1, "d_eff"]) and table.loc[1, "reason"] == "no unit varies"
+    with pytest.raises(ValueError, match="h_<i>"):
+        hidden_matrix(hidden[["t", "agent"]])
+
+
+def test_plsc_by_distance_finds_sharing_only_where_planted():
+    rng = np.random.default_rng(0)
+    t = 900
+    dist = np.repeat([5.0, 50.0, 500.0], t // 3)  # close, mid and far thirds of the episode
+    shared = rng.normal(size=(t, 2)) * (dist == 5.0)[:, None]  # the agents share 2 dimensions only when close
+    h_a = shared @ rng.normal(size=(2, 10)) + rng.normal(size=(t, 10))
+    h_b = shared @ rng.normal(size=(2, 8)) + rng.normal(size=(t, 8))
+    out = plsc_by_distance(h_a, h_b, dist, rng=0)
+    assert out["n_significant"].tolist() == [2, 0, 0] and out["n_steps"].tolist() == [300, 300, 300]
+    assert out["hi_cm"].tolist() == [10.0, 100.0, np.inf] and (out["reason"] == "").all()
+    sparse = plsc_by_distance(h_a[:20], h_b[:20], np.full(20, 500.0), rng=0)
+    assert sparse.loc[0, "reason"].startswith("need a T x D") and np.isnan(sparse.loc[0, "n_significant"])

@@ -1,0 +1,134 @@
+"""Signalling analyses with known answers: IDIs, power-law fits, EOD rate vs distance and around events."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from efish.analysis.signalling import (
+    eod_rate_by_distance,
+    fit_power_law,
+    idi_histogram,
+    idis,
+    load_real_idis,
+    peri_event_rate,
+    rate_advantage_vs_size,
+)
+
+STEP_MS = 1000.0 / 83.0
+
+
+def agent_steps(eod, agent=0, episode=0, **columns) -> pd.DataFrame:
+    """One agent-episode with the given EOD train; other columns constant unless given."""
+    eod = np.asarray(eod, dtype=bool)
+    base = {"condition": "c", "episode": episode, "agent": agent, "t": np.arange(eod.size), "eod": eod,
+            "ate": False, "bit": False, "was_bitten": False, "size": 0.5, "x_cm": 10.0, "y_cm": 10.0,
+            "dist_agent_cm": 50.0, "dist_food_cm": 5.0, "dist_wall_cm": 5.0}
+    return pd.DataFrame({**base, **columns})
+
+
+def test_idis_are_step_differences_per_agent_episode():
+    steps = pd.concat([agent_steps([1, 0, 0, 1, 1, 0]), agent_steps([0, 1, 0, 0, 0, 1], agent=1)])
+    out = idis(steps.sample(frac=1.0, random_state=0))  # row order must not matter
+    assert out["idi_steps"].tolist() == [3, 1, 4] and out["agent"].tolist() == [0, 0, 1]
+    np.testing.assert_allclose(out["idi_ms"], np.array([3, 1, 4]) * STEP_MS)
+    assert idis(agent_steps([0, 0, 1])).empty
+
+
+def test_power_law_alpha_recovered_on_1e4_samples():
+    u = np.random.default_rng(0).uniform(size=10_000)
+    x = 12.0 * (1 - u) ** (-1 / (2.5 - 1))  # inverse CDF of a continuous power law, alpha 2.5, xmin 12
+    fit = fit_power_law(x)
+    assert abs(fit["alpha"] - 2.5) < 0.1 and fit["n"] == 10_000 and fit["xmin"] == 12.0
+    assert fit["R_exponential"] > 0 and fit["p_exponential"] < 0.05  # a power law beats an exponential
+
+
+def test_lognormal_data_prefer_lognormal():
+    x = np.random.default_rng(0).lognormal(mean=4.0, sigma=0.8, size=10_000)
+    fit = fit_power_law(x)
+    assert fit["R_lognormal"] < 0 and fit["p_lognormal"] < 0.05 and fit["reason"] == ""
+
+
+@pytest.mark.parametrize(("data", "reason"), [([], "fewer than 10"), ([np.nan] * 20, "fewer than 10"),
+                                              ([5.0] * 50, "fewer than 10"), ([20.0] * 50, "all IDIs >= xmin")])
+def test_power_law_degenerate(data, reason):
+    fit = fit_power_law(np.asarray(data))
+    assert np.isnan(fit["alpha"]) and np.isnan(fit["R_lognormal"]) and fit["reason"].startswith(reason)
+
+
+def test_idi_histogram_density_integrates_to_one():
+    h = idi_histogram(np.random.default_rng(0).uniform(15, 2000, 500))
+    assert len(h) == 50 and h["count"].sum() == 500
+    assert np.sum(h["density"] * (h["bin_hi_ms"] - h["bin_lo_ms"])) == pytest.approx(1.0)
+    assert h["bin_lo_ms"].iloc[0] == 10.0 and h["bin_hi_ms"].iloc[-1] == pytest.approx(3000.0)
+
+
+def test_eod_rate_by_distance_bins_mean_and_drops_sparse_bins():
+    t = 400
+    dist = np.where(np.arange(t) < 200, 1.0, 9.0)  # two long stretches: near and far from food
+    dist[200:230] = np.nan                          # no food in sight while the rate window changes over
+    dist[300:303] = 5.0                             # three samples in a middle bin: dropped (< 5)
+    steps = agent_steps(np.arange(t) < 215, dist_food_cm=dist)  # fires while near (and a bit after)
+    out = eod_rate_by_distance(steps, "food")
+    assert out["bin"].tolist() == [1, 13] and (out["reason"] == "").all()
+    assert out["mean_hz"].tolist() == pytest.approx([83.0, 0.0])
+    assert out.loc[0, "bin_lo_cm"] == pytest.approx(2 / 3) and out.loc[0, "n"] == 200 - 10  # full windows only
+    assert out["sem_hz"].tolist() == pytest.approx([0.0, 0.0])
+
+
+def test_eod_rate_by_distance_degenerate_and_errors():
+    far = eod_rate_by_distance(agent_steps(np.ones(50), dist_food_cm=np.nan), "food")
+    assert len(far) == 1 and np.isnan(far.loc[0, "mean_hz"]) and "no distance bin" in far.loc[0, "reason"]
+    assert eod_rate_by_distance(agent_steps([]), "wall").loc[0, "reason"] == "empty steps table"
+    with pytest.raises(ValueError, match="to must be one of"):
+        eod_rate_by_distance(agent_steps(np.ones(50)), "pellet")
+    with pytest.raises(ValueError, match="dist_agent_cm"):
+        eod_rate_by_distance(agent_steps(np.ones(50)).drop(columns="dist_agent_cm"), "agent")
+
+
+def test_peri_event_rate_rises_after_events():
+    t, events = 1000, [200, 450, 700]
+    ate, eod = np.zeros(t, bool), np.zeros(t, bool)
+    for e in events:
+        ate[e] = True
+        eod[e:e + 40] = True  # fires for 40 steps after eating
+    out = peri_event_rate(agent_steps(eod, ate=ate), "ate").set_index("lag")
+    assert out.loc[20, "mean_hz"] == pytest.approx(83.0) and out.loc[-50, "mean_hz"] == 0.0
+    assert (out["n_agents"] == 1).all() and out["sem_hz"].isna().all()  # one agent-episode: no SEM
+    assert len(out) == 201 and out.loc[-100, "lag_ms"] == pytest.approx(-100 * STEP_MS)
+
+
+def test_peri_event_rate_needs_enough_events():
+    ate = np.zeros(300, bool)
+    ate[[50, 150]] = True
+    out = peri_event_rate(agent_steps(np.ones(300), ate=ate), "ate")
+    assert len(out) == 1 and np.isnan(out.loc[0, "mean_hz"]) and "3 or more 'ate' events" in out.loc[0, "reason"]
+    with pytest.raises(ValueError, match="event must be one of"):
+        peri_event_rate(agent_steps(np.ones(300)), "eaten")
+
+
+def test_rate_advantage_of_a_close_pair():
+    on, off = np.ones(100), np.zeros(100)
+    steps = pd.concat([agent_steps(on, size=0.8), agent_steps(off, agent=1, size=0.3, x_cm=15.0)])
+    out = rate_advantage_vs_size(steps)
+    assert len(out) == 1 and out.loc[0, "size_advantage"] == pytest.approx(0.5)
+    assert out.loc[0, "rate_advantage_hz"] == pytest.approx(83.0) and out.loc[0, "n_steps"] == 100 - 19
+    far = rate_advantage_vs_size(steps.assign(x_cm=np.r_[np.full(100, 10.0), np.full(100, 90.0)]))
+    assert np.isnan(far.loc[0, "rate_advantage_hz"]) and "within 10.0 cm" in far.loc[0, "reason"]
+
+
+def test_load_real_idis(tmp_path):
+    missing = load_real_idis(None)
+    assert np.isnan(missing.loc[0, "idi_ms"]) and "real_fish_idis is unset" in missing.loc[0, "reason"]
+    assert "fewer than 10" in fit_power_law(missing["idi_ms"])["reason"]
+    df = pd.DataFrame({"fish": [1, 1, 2], "idi_ms": [20.0, 35.5, 80.0]})
+    df.to_csv(tmp_path / "idis.csv", index=False)
+    df.to_parquet(tmp_path / "idis.parquet")
+    for name in ("idis.csv", "idis.parquet"):
+        assert load_real_idis(tmp_path / name)["idi_ms"].tolist() == [20.0, 35.5, 80.0]
+    df.rename(columns={"idi_ms": "ms"}).to_csv(tmp_path / "bad.csv", index=False)
+    with pytest.raises(ValueError, match="idi_ms"):
+        load_real_idis(tmp_path / "bad.csv")
+    with pytest.raises(FileNotFoundError):
+        load_real_idis(tmp_path / "absent.csv")

@@ -1,0 +1,22 @@
+"""``efish bench physics`` and ``efish bench env`` report what they promise on tiny sizes (never timing asserts)."""
+
+from __future__ import annotations
+
+from efish.bench.env import bench_env
+from efish.bench.physics import bench_physics
+
+from ..helpers import cfg_with
+
+
+def test_physics_bench_reports_positive_rates_and_agrees_with_the_reference():
+    r = bench_physics(cfg_with("bench.scenes=2", "bench.repeats=1", "bench.reference_scenes=1",
+                               "bench.reference_rounds=1"))
+    assert r["fast_agent_steps_per_s"] > 0 and r["reference_agent_steps_per_s"] > 0
+    assert r["max_abs_diff_normalised"] <= 1e-6
+
+
+def test_env_bench_has_a_row_per_scene_with_positive_rates():
+    rows = bench_env(cfg_with("bench.reference_rounds=1"), num_envs=2, steps=3, reference_steps=1)
+    assert len(rows) == 2
+    for row in rows:
+        assert all(v > 0 for k, v in row.items() if isinstance(v, float))
