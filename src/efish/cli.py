@@ -41,6 +41,7 @@ def _parser() -> argparse.ArgumentParser:
     tr = sub.add_parser("train", help="train one seed with recurrent MAPPO (resumes from a checkpoint in --out)")
     tr.add_argument("overrides", nargs="*")
     tr.add_argument("--out", type=Path, help="output folder (default results/{scale}/train/seed_{seed})")
+    tr.add_argument("--restart", action="store_true", help="discard a checkpoint in --out and start afresh")
     asy = sub.add_parser("assay", help="run an assay with a trained policy into Parquet tables")
     asy.add_argument("overrides", nargs="*")
     asy.add_argument("--policy", type=Path, required=True, help="training folder, final.pt or checkpoint.pt")
@@ -81,6 +82,20 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
+def _metadata(folder: Path, cfg, started, args, name: str = "provenance.json", **extra) -> None:
+    """config.yaml and provenance (with the command's overrides) beside an output."""
+    from .io import write_run_metadata
+
+    write_run_metadata(folder, to_yaml(cfg), started, {"overrides": list(args.overrides), **extra}, name=name)
+
+
+def _run_folder(cfg, args, root: str = "results") -> Path:
+    """Default output root of this command: ``results/<run>`` (the run named by the scale and overrides)."""
+    from .config import run_name
+
+    return Path(root) / run_name(cfg.scale.name, [o for o in args.overrides if not o.startswith("scale=")])
+
+
 def _progress(items: list, label: str):
     """tqdm bar on a terminal, one plain line per item otherwise."""
     if sys.stderr.isatty():
@@ -95,19 +110,34 @@ def _progress(items: list, label: str):
     return lines()
 
 
+class ReturnLog:
+    """The return part of a training log line: the mean return of the episodes that ended since the last line."""
+
+    def __init__(self):
+        self.ended = 0
+
+    def line(self, row: dict) -> str:
+        k = int(row.get("episodes_ended", 0))
+        self.ended += k
+        if k:
+            return f"return {row['episode_return']:.3f} ({k} episodes)"
+        return "no episode ended yet" if self.ended == 0 else "no episode ended since the last line"
+
+
 def _train(args, cfg, started) -> None:
-    from .io import write_run_metadata
     from .rl.train import train
 
-    out = args.out or Path(f"results/{cfg.scale.name}/train/seed_{cfg.train.seed}")
+    out = args.out or _run_folder(cfg, args) / "train" / f"seed_{cfg.train.seed}"
     bar = None
     if sys.stderr.isatty():
         from tqdm import tqdm
 
         bar = tqdm(unit="update", desc=f"seed {cfg.train.seed}")
 
+    log = ReturnLog()
+
     def report(row: dict, total: int) -> None:
-        line = (f"update {row['update']}/{total}  env-steps {row['env_steps']:,}  return {row['episode_return']:.3f}  "
+        line = (f"update {row['update']}/{total}  env-steps {row['env_steps']:,}  {log.line(row)}  "
                 f"{row['env_steps_per_s']:,.0f} env-steps/s")
         if bar is not None:
             bar.total = total
@@ -116,30 +146,29 @@ def _train(args, cfg, started) -> None:
         else:
             print(line, file=sys.stderr, flush=True)
 
-    df = train(cfg, out, progress=report)
+    df = train(cfg, out, progress=report, restart=args.restart)
     if bar is not None:
         bar.close()
-    write_run_metadata(out, to_yaml(cfg), started)
+    _metadata(out, cfg, started, args)
     print(f"trained {len(df)} updates into {out}")
 
 
 def _assay(args, cfg, started) -> None:
-    from .io import write_run_metadata
     from .rl.policy import load_policy
     from .rollout.assay import run_assay
     from .rollout.tables import write_tables
 
     policy = load_policy(args.policy)
-    out = args.out or Path(f"results/{cfg.scale.name}/assays/{cfg.assay.name}")
+    out = args.out or _run_folder(cfg, args) / "assays" / cfg.assay.name
     tables = run_assay(args.overrides, policy)
     write_tables(tables, out)
-    write_run_metadata(out, to_yaml(cfg), started, {"policy": str(args.policy)})
+    _metadata(out, cfg, started, args, policy=str(args.policy))
     print(f"wrote {', '.join(f'{k}.parquet ({len(v)} rows)' for k, v in tables.items())} to {out}")
 
 
 def _select(args, cfg, started) -> None:
     from .analysis.selection import select_seed
-    from .io import atomic_path, write_run_metadata, write_text_atomic
+    from .io import atomic_path, write_text_atomic
 
     table, chosen = select_seed(args.episodes)
     if table["fallback"].any():
@@ -147,7 +176,7 @@ def _select(args, cfg, started) -> None:
     with atomic_path(args.out / "ranking.parquet") as tmp:
         table.to_parquet(tmp, index=False)
     write_text_atomic(args.out / "selected_seed.txt", f"{chosen}\n")
-    write_run_metadata(args.out, to_yaml(cfg), started, {"episodes": [str(p) for p in args.episodes]})
+    _metadata(args.out, cfg, started, args, episodes=[str(p) for p in args.episodes])
     print(table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
     print(f"selected seed {chosen}")
 
@@ -155,35 +184,56 @@ def _select(args, cfg, started) -> None:
 def _figure(args, cfg, started) -> None:
     from .figures.registry import figures, panels_for
     from .figures.render import render_page, render_panel
-    from .io import write_run_metadata
 
-    results = args.results or Path(f"results/{cfg.scale.name}")
-    out = args.out or Path(f"figures/{cfg.scale.name}")
-    if "/" in args.key:
+    results = args.results or _run_folder(cfg, args)
+    out = args.out or _run_folder(cfg, args, root="figures")
+    if args.key == "bench/accuracy":
+        written = _accuracy_figure(results, out)
+    elif "/" in args.key:
         written = render_panel(args.key, results, out, cfg.scale.seeds)
     else:
         if args.key not in figures():
-            raise ValueError(f"unknown figure {args.key!r}: choose one of {', '.join(figures())}")
+            raise ValueError(f"unknown figure {args.key!r}: choose one of {', '.join(figures())}, bench/accuracy")
         drawable = [p for p in panels_for(cfg.scale.assays) if p.figure == args.key]
         written = render_page(args.key, drawable, results, out, cfg.scale.seeds)
-    write_run_metadata(written[0].parent, to_yaml(cfg), started, {"figure": args.key, "results": str(results)})
+    # one provenance per drawn output (a figure folder holds many panels), one config per folder
+    _metadata(written[0].parent, cfg, started, args, name=f"{written[0].stem}.provenance.json", figure=args.key,
+              results=str(results))
     print("wrote " + ", ".join(map(str, written)))
+
+
+def _accuracy_figure(results: Path, out: Path) -> list[Path]:
+    """The accuracy-vs-time figure (PNG and PDF) from ``results/bench/bench_accuracy.parquet``."""
+    from .bench.accuracy import plot_accuracy
+    from .io import atomic_path, read_parquet
+
+    table = results / "bench" / "bench_accuracy.parquet"
+    if not table.is_file():
+        raise ValueError(f"the accuracy figure needs {table}, which does not exist (run efish bench accuracy first)")
+    df = read_parquet(table, "the accuracy table")
+    written = []
+    for ext in ("png", "pdf"):
+        path = out / "bench" / f"bench_accuracy.{ext}"
+        with atomic_path(path) as tmp:
+            plot_accuracy(df, tmp)
+        written.append(path)
+    return written
 
 
 def _bench_physics(args, cfg, started) -> None:
     from .bench.physics import bench_physics, format_physics
-    from .io import write_run_metadata, write_text_atomic
+    from .io import write_text_atomic
 
     result = bench_physics(cfg)
     print(json.dumps(result, indent=2) if args.json else format_physics(result))
     if args.out:
         write_text_atomic(args.out / "bench_physics.json", json.dumps(result, indent=2) + "\n")
-        write_run_metadata(args.out, to_yaml(cfg), started)
+        _metadata(args.out, cfg, started, args)
 
 
 def _bench_accuracy(args, cfg, started) -> None:
     from .bench.accuracy import bench_accuracy, plot_accuracy
-    from .io import atomic_path, write_run_metadata
+    from .io import atomic_path
 
     df = bench_accuracy(cfg, progress=lambda s: _progress(s, "accuracy"))
     args.out.mkdir(parents=True, exist_ok=True)
@@ -192,7 +242,7 @@ def _bench_accuracy(args, cfg, started) -> None:
     for ext in ("png", "pdf"):
         with atomic_path(args.out / f"bench_accuracy.{ext}") as tmp:
             plot_accuracy(df, tmp)
-    write_run_metadata(args.out, to_yaml(cfg), started)
+    _metadata(args.out, cfg, started, args)
     if args.json:
         print(df.to_json(orient="records", indent=1))
     else:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import os
 import platform
+import re
 import subprocess
 import sys
 import tempfile
@@ -14,12 +15,17 @@ from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 from typing import Iterator
 
+_PARTIAL = re.compile(r"^\..+\.[a-z0-9_]{8}(\.[A-Za-z0-9]+)?$")  # tempfile.mkstemp names of atomic_path
 PROVENANCE_PACKAGES = ("numpy", "numba", "pandas", "pyarrow", "hydra-core", "omegaconf", "matplotlib", "torch")
 
 
 @contextmanager
-def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
-    """Yield a temporary path beside ``path``; rename it into place only if the block succeeds."""
+def atomic_path(path: str | os.PathLike, commit: bool = True) -> Iterator[Path]:
+    """Yield a temporary path beside ``path``; rename it into place only if the block succeeds.
+
+    ``commit=False`` leaves the rename to the caller (several files renamed
+    together); the temporary file is removed on leaving the block either way.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
@@ -27,10 +33,40 @@ def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
     tmp_path = Path(tmp)
     try:
         yield tmp_path
-        os.replace(tmp_path, path)
+        if commit:
+            os.replace(tmp_path, path)
     finally:
         if tmp_path.exists():
             tmp_path.unlink()
+
+
+def read_parquet(path: str | os.PathLike, what: str = "a table"):
+    """A Parquet file as a DataFrame; a truncated or foreign file is one clear ``ValueError`` naming it.
+
+    A missing file stays a ``FileNotFoundError`` (an ``OSError``, which the CLI reports in one line too).
+    """
+    import pandas as pd
+
+    try:
+        return pd.read_parquet(path)
+    except OSError:
+        raise
+    except Exception as exc:  # pyarrow raises its own types for files that are not Parquet
+        raise ValueError(f"cannot read {path} as {what} ({type(exc).__name__}): rerun the job that writes it") from None
+
+
+def remove_partial_writes(folder: str | os.PathLike) -> list[Path]:
+    """Delete the temporary files :func:`atomic_path` leaves when its process is killed (SIGKILL skips cleanup).
+
+    They are named ``.<output name>.<8 random characters><suffix>``; nothing else is touched.
+    """
+    folder = Path(folder)
+    if not folder.is_dir():
+        return []
+    stale = [p for p in folder.iterdir() if p.is_file() and _PARTIAL.match(p.name)]
+    for path in stale:
+        path.unlink(missing_ok=True)
+    return stale
 
 
 def write_text_atomic(path: str | os.PathLike, text: str) -> None:
@@ -65,8 +101,13 @@ def provenance(started: datetime, extra: dict | None = None) -> dict:
     }
 
 
-def write_run_metadata(folder: str | os.PathLike, config_yaml: str, started: datetime, extra: dict | None = None) -> None:
-    """``config.yaml`` (fully resolved) and ``provenance.json`` beside an output."""
+def write_run_metadata(folder: str | os.PathLike, config_yaml: str, started: datetime, extra: dict | None = None,
+                       name: str = "provenance.json") -> None:
+    """``config.yaml`` (fully resolved) and a provenance file (``name``) beside an output.
+
+    Folders that hold several outputs of one run (figure panels) give each its
+    own provenance file, ``<output>.provenance.json``; their config is the run's.
+    """
     folder = Path(folder)
     write_text_atomic(folder / "config.yaml", config_yaml)
-    write_text_atomic(folder / "provenance.json", json.dumps(provenance(started, extra), indent=2) + "\n")
+    write_text_atomic(folder / name, json.dumps(provenance(started, extra), indent=2) + "\n")

@@ -49,14 +49,47 @@ def test_truncated_checkpoint_is_one_clear_error(tmp_path):
     train(tiny(1), tmp_path)
     data = (tmp_path / CHECKPOINT).read_bytes()
     (tmp_path / CHECKPOINT).write_bytes(data[: len(data) // 2])
-    with pytest.raises(ValueError, match="cannot read checkpoint"):
+    with pytest.raises(ValueError, match="cannot read checkpoint .*--restart"):
         train(tiny(2), tmp_path)
 
 
-def test_checkpoint_of_another_architecture_is_rejected(tmp_path):
+def test_checkpoint_of_another_config_is_rejected_naming_the_keys(tmp_path):
     train(tiny(1), tmp_path)
-    with pytest.raises(ValueError, match="architecture"):
+    with pytest.raises(ValueError, match=r"another config \(train.hidden differ\).*--restart"):
         train(tiny(2, "train.hidden=8"), tmp_path)
+    with pytest.raises(ValueError, match=r"\(physics.tolerance, train.lr differ\)"):
+        train(tiny(2, "train.lr=1e-3", "physics.tolerance=0"), tmp_path)
+
+
+def test_result_neutral_keys_still_resume(tmp_path):
+    train(tiny(1), tmp_path)
+    df = train(tiny(2, "train.threads=2", "train.checkpoint_every=5"), tmp_path)  # a longer run, other threads
+    assert list(df["update"]) == [1, 2]
+
+
+def test_a_checkpoint_past_the_run_is_rejected(tmp_path):
+    train(tiny(2), tmp_path)
+    with pytest.raises(ValueError, match="past this run's 1 updates"):
+        train(tiny(1), tmp_path)
+
+
+def test_restart_discards_the_checkpoint(tmp_path):
+    train(tiny(1), tmp_path)
+    df = train(tiny(1, "train.lr=1e-3"), tmp_path, restart=True)
+    assert list(df["update"]) == [1]
+    assert torch.load(tmp_path / CHECKPOINT, weights_only=False)["config"]["train"]["lr"] == 1e-3
+
+
+def test_a_finished_run_rerun_writes_its_outputs_again(tmp_path):
+    train(tiny(2), tmp_path)
+    before = weights(tmp_path)
+    (tmp_path / FINAL).unlink()
+    (tmp_path / METRICS).unlink()  # what Snakemake does before rerunning a job
+    df = train(tiny(2), tmp_path)
+    assert list(df["update"]) == [1, 2] and (tmp_path / FINAL).exists()
+    assert list(pd.read_parquet(tmp_path / METRICS)["update"]) == [1, 2]
+    for key, value in before.items():
+        torch.testing.assert_close(weights(tmp_path)[key], value, rtol=0, atol=0)
 
 
 def test_loaded_policy_steps_the_env_with_hidden_states_exposed(tmp_path):

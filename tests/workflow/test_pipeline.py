@@ -16,6 +16,7 @@ import pytest
 
 from efish.analysis.selection import RANKING_COLUMNS
 from efish.bench.accuracy import COLUMNS
+from efish.config import run_name
 from efish.rollout.schema import SCHEMAS, check_file
 
 REPO = Path(__file__).resolve().parents[2]
@@ -76,13 +77,22 @@ def test_every_table_matches_its_schema(smoke_run):
 @pytest.mark.slow
 def test_every_output_folder_has_config_and_provenance(smoke_run):
     folders = {p.parent for p in (smoke_run / "results/smoke").glob("**/*.parquet")}
-    folders |= {p.parent for p in (smoke_run / "figures/smoke").glob("*/*.png")}
-    folders.discard(smoke_run / "figures/smoke/bench")  # a copy of results/smoke/bench's figure
     for folder in folders:
-        assert (folder / "config.yaml").is_file(), folder
-        prov = json.loads((folder / "provenance.json").read_text())
-        assert prov["command"] and prov["finished"] >= prov["started"], folder
         assert "name: smoke" in (folder / "config.yaml").read_text(), folder
+        check_provenance(folder / "provenance.json")
+    # figures: every drawn PNG (panels, pages, the accuracy figure) has a PDF and its own provenance
+    drawn = list((smoke_run / "figures/smoke").glob("**/*.png"))
+    assert any(p.parent.name == "bench" for p in drawn) and any(p.parent.name == "smoke" for p in drawn)
+    for png in drawn:
+        assert png.with_suffix(".pdf").is_file(), png
+        assert "name: smoke" in (png.parent / "config.yaml").read_text(), png
+        check_provenance(png.with_name(f"{png.stem}.provenance.json"))
+
+
+def check_provenance(path: Path) -> None:
+    prov = json.loads(path.read_text())
+    assert prov["command"] and prov["finished"] >= prov["started"], path
+    assert prov["overrides"] and prov["overrides"][0] == "scale=smoke", path
 
 
 @pytest.mark.slow
@@ -157,7 +167,25 @@ def test_scale_is_recorded_in_the_resolved_config(smoke_run):
 def test_unknown_scale_fails_before_any_job(tmp_path):
     result = dry_run(tmp_path, "--config", "scale=huge")
     assert result.returncode != 0
-    assert "unknown scale 'huge'" in result.stdout + result.stderr
+    assert result.stderr.strip().splitlines()[-1].startswith("efish workflow: efish config: unknown scale 'huge'")
+
+
+def test_a_misspelt_config_key_is_one_line_naming_the_allowed_ones(tmp_path):
+    result = dry_run(tmp_path, "--config", "scal=smoke")
+    assert result.returncode != 0
+    assert result.stderr.strip() == ("efish workflow: unknown --config key(s) scal: the allowed keys are scale, "
+                                     "overrides, run")
+    assert not (tmp_path / "results").exists()
+
+
+def test_overrides_and_run_names_give_their_own_folders(tmp_path):
+    for config, folder in ((["scale=smoke"], "smoke"),
+                           (["scale=smoke", "overrides=train.lr=3e-4"], run_name("smoke", ["train.lr=3e-4"])),
+                           (["scale=smoke", "overrides=train.lr=3e-4", "run=mine"], "mine")):
+        result = dry_run(tmp_path, "--config", *config)
+        assert result.returncode == 0, result.stderr[-2000:]
+        assert f"results/{folder}/train/seed_1/final.pt" in result.stdout
+        assert f"figures/{folder}/bench/bench_accuracy.pdf" in result.stdout
 
 
 def test_workflow_lints_clean():
@@ -181,10 +209,10 @@ def test_a_killed_training_job_resumes_from_its_checkpoint(tmp_path):
     for name in ("Snakefile", "workflow", "config"):
         src = REPO / name
         (shutil.copytree if src.is_dir() else shutil.copy)(src, tmp_path / name)
-    seed_dir = tmp_path / "results/smoke/train/seed_1"
-    command = ["snakemake", "results/smoke/train/seed_1/final.pt", "--cores", "1", "--rerun-incomplete",
+    seed_dir = tmp_path / "results/kill/train/seed_1"
+    command = ["snakemake", "results/kill/train/seed_1/final.pt", "--cores", "1", "--rerun-incomplete",
                "--directory", str(tmp_path), "--snakefile", str(tmp_path / "Snakefile"), "--config", "scale=smoke",
-               "overrides=scale.train_steps=6000 train.checkpoint_every=1"]
+               "overrides=scale.train_steps=6000 train.checkpoint_every=1", "run=kill"]
     first = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True,
                              env=smoke_env(tmp_path))
     deadline = time.monotonic() + 240
@@ -197,8 +225,25 @@ def test_a_killed_training_job_resumes_from_its_checkpoint(tmp_path):
 
     second = subprocess.run(command, capture_output=True, text=True, timeout=600, env=smoke_env(tmp_path))
     assert second.returncode == 0, second.stderr[-2000:]
-    log = (tmp_path / "results/smoke/logs/train/seed_1.log").read_text()
+    log = (tmp_path / "results/kill/logs/train/seed_1.log").read_text()
     resumed = re.search(r"resumed from .* at update (\d+)", log)
     assert resumed and int(resumed.group(1)) >= 1, log[-2000:]
     metrics = pd.read_parquet(seed_dir / "metrics.parquet")
     assert list(metrics["update"]) == list(range(1, 61))  # nothing lost, nothing repeated
+
+
+@pytest.mark.slow
+def test_the_readme_override_example_reruns_cleanly_beside_the_default_run(smoke_run):
+    """After a finished run, the override example runs in its own folder, twice, and the default stays as it was."""
+    before = {p: p.stat().st_mtime_ns for p in (smoke_run / "results/smoke").glob("**/*") if p.is_file()}
+    command = ["snakemake", "--cores", "2", "--config", "scale=smoke",
+               "overrides=physics.tolerance=1e-6 train.lr=3e-4", "--directory", str(smoke_run),
+               "--snakefile", str(smoke_run / "Snakefile")]
+    for attempt in range(2):
+        result = subprocess.run(command, capture_output=True, text=True, timeout=900, env=smoke_env(smoke_run))
+        assert result.returncode == 0, (attempt, result.stderr[-3000:])
+    run = smoke_run / "results" / run_name("smoke", ["physics.tolerance=1e-6", "train.lr=3e-4"])
+    assert "tolerance: 1.0e-06" in (run / "train/seed_1/config.yaml").read_text()
+    assert "Nothing to be done" in result.stdout + result.stderr  # the second attempt reuses the first's outputs
+    after = {p: p.stat().st_mtime_ns for p in (smoke_run / "results/smoke").glob("**/*") if p.is_file()}
+    assert after == before

@@ -7,13 +7,13 @@ rule assay:
     input:
         policy=assay_policy,
     output:
-        steps="results/{scale}/assays/{assay}/steps.parquet",
-        episodes="results/{scale}/assays/{assay}/episodes.parquet",
-        food="results/{scale}/assays/{assay}/food.parquet",
+        steps="results/{run}/assays/{assay}/steps.parquet",
+        episodes="results/{run}/assays/{assay}/episodes.parquet",
+        food="results/{run}/assays/{assay}/food.parquet",
     log:
-        "results/{scale}/logs/assays/{assay}.log",
+        "results/{run}/logs/assays/{assay}.log",
     benchmark:
-        "results/{scale}/benchmarks/assays/{assay}.tsv"
+        "results/{run}/benchmarks/assays/{assay}.tsv"
     params:
         overrides=ARGS,
         out=folder_of("steps"),
@@ -21,5 +21,5 @@ rule assay:
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish assay assay={wildcards.assay} scale={wildcards.scale} {params.overrides} --policy {input.policy} "
+        "efish assay assay={wildcards.assay} {params.overrides} --policy {input.policy} "
         "--out {params.out} > {log} 2>&1"

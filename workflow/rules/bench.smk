@@ -3,11 +3,11 @@
 
 rule bench_physics:
     output:
-        "results/{scale}/bench/bench_physics.json",
+        "results/{run}/bench/bench_physics.json",
     log:
-        "results/{scale}/logs/bench_physics.log",
+        "results/{run}/logs/bench_physics.log",
     benchmark:
-        "results/{scale}/benchmarks/bench_physics.tsv"
+        "results/{run}/benchmarks/bench_physics.tsv"
     params:
         overrides=ARGS,
         out=folder_of(0),
@@ -15,17 +15,17 @@ rule bench_physics:
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish bench physics scale={wildcards.scale} {params.overrides} --out {params.out} > {log} 2>&1"
+        "efish bench physics {params.overrides} --out {params.out} > {log} 2>&1"
 
 
 rule bench_accuracy:
     output:
-        table="results/{scale}/bench/bench_accuracy.parquet",
-        figure="results/{scale}/bench/bench_accuracy.png",
+        table="results/{run}/bench/bench_accuracy.parquet",
+        figure="results/{run}/bench/bench_accuracy.png",
     log:
-        "results/{scale}/logs/bench_accuracy.log",
+        "results/{run}/logs/bench_accuracy.log",
     benchmark:
-        "results/{scale}/benchmarks/bench_accuracy.tsv"
+        "results/{run}/benchmarks/bench_accuracy.tsv"
     params:
         overrides=ARGS,
         out=folder_of("table"),
@@ -33,21 +33,28 @@ rule bench_accuracy:
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish bench accuracy scale={wildcards.scale} {params.overrides} --out {params.out} > {log} 2>&1"
+        "efish bench accuracy {params.overrides} --out {params.out} > {log} 2>&1"
 
 
 rule figure_bench_accuracy:
     input:
-        "results/{scale}/bench/bench_accuracy.png",
+        "results/{run}/bench/bench_accuracy.parquet",
     output:
-        report(
-            "figures/{scale}/bench/bench_accuracy.png",
+        png=report(
+            "figures/{run}/bench/bench_accuracy.png",
             caption="../report/bench_accuracy.rst",
             category="Benchmarks",
         ),
+        pdf="figures/{run}/bench/bench_accuracy.pdf",
     log:
-        "results/{scale}/logs/figure_bench_accuracy.log",
+        "results/{run}/logs/figure_bench_accuracy.log",
+    benchmark:
+        "results/{run}/benchmarks/figures/bench_accuracy.tsv"
+    params:
+        overrides=ARGS,
+        out=folder_of("png", up=1),
     conda:
         "../envs/efish.yaml"
     shell:
-        "cp {input} {output} 2> {log}"
+        "efish figure bench/accuracy {params.overrides} --results results/{wildcards.run} --out {params.out} "
+        "> {log} 2>&1"

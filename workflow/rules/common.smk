@@ -1,17 +1,33 @@
 # Shared settings: the scale and its efish config, read once. Every number the
 # rules need (seeds, assays, panels) comes from efish's config; none is repeated here.
+import re
 import shlex
+import sys
 from pathlib import Path
 
-from snakemake.exceptions import WorkflowError
-
-from efish.config import ConfigError, compose
+from efish.config import ConfigError, compose, run_name
 from efish.figures.registry import PANELS, panels_for
 from efish.figures.render import input_paths
 
+CONFIG_KEYS = ("scale", "overrides", "run")
+
+
+def fail(message):
+    """Stop the workflow with one line on stderr (no traceback), before any job runs."""
+    sys.stderr.write(f"efish workflow: {message}\n")
+    sys.exit(1)
+
+
+if unknown := sorted(set(config) - set(CONFIG_KEYS)):
+    fail(f"unknown --config key(s) {', '.join(unknown)}: the allowed keys are {', '.join(CONFIG_KEYS)}")
 SCALE = str(config.get("scale", "laptop"))
 # Extra Hydra overrides for every efish call, e.g. --config overrides="physics.tolerance=1e-6"
 OVERRIDES = shlex.split(str(config.get("overrides", "")))
+# The run's folders: results/{RUN}/ and figures/{RUN}/. The scale as shipped, else the scale and a hash of the
+# overrides, or --config run=NAME; two configs never share a folder.
+RUN = str(config.get("run") or run_name(SCALE, OVERRIDES))
+if not re.fullmatch(r"[A-Za-z0-9_.\-]+", RUN):
+    fail(f"run={RUN!r} is not a folder name: use letters, digits, '_', '.' and '-'")
 
 
 def efish_config(*overrides):
@@ -20,12 +36,12 @@ def efish_config(*overrides):
     try:
         return compose([f"scale={SCALE}", *OVERRIDES, *overrides])
     except ConfigError as exc:
-        raise WorkflowError(f"efish config: {exc}") from None
+        fail(f"efish config: {exc}")
 
 
 CFG = efish_config()
 SEEDS = list(range(1, CFG.scale.seeds + 1))
-ARGS = " ".join(shlex.quote(o) for o in OVERRIDES)  # passed on to every efish call
+ARGS = " ".join(shlex.quote(o) for o in [f"scale={SCALE}", *OVERRIDES])  # passed on to every efish call
 
 
 def assay_config(name):
@@ -38,7 +54,7 @@ DRAWABLE = panels_for(ASSAYS)
 
 
 wildcard_constraints:
-    scale=SCALE,
+    run=re.escape(RUN),
     seed=r"\d+",
     assay=r"[A-Za-z0-9_\-]+",
 
@@ -51,20 +67,20 @@ def folder_of(name, up=0):
 
 def panel_inputs(panel):
     """Every table a panel reads, at this scale (the same expansion efish figure uses)."""
-    return [str(path) for paths in input_paths(panel, Path(f"results/{SCALE}"), len(SEEDS)).values() for path in paths]
+    return [str(path) for paths in input_paths(panel, Path(f"results/{RUN}"), len(SEEDS)).values() for path in paths]
 
 
 def selected_policy(wildcards):
     """The final checkpoint of the seed the select_seed checkpoint chose."""
-    chosen = checkpoints.select_seed.get(scale=wildcards.scale).output.seed
+    chosen = checkpoints.select_seed.get(run=wildcards.run).output.seed
     seed = int(Path(chosen).read_text().strip())
-    return f"results/{wildcards.scale}/train/seed_{seed}/final.pt"
+    return f"results/{wildcards.run}/train/seed_{seed}/final.pt"
 
 
 def assay_policy(wildcards):
     """The policy an assay's config asks for: the homing policy, or the selected foraging seed."""
     if assay_config(wildcards.assay).assay.policy == "homing":
-        return f"results/{wildcards.scale}/train/homing/final.pt"
+        return f"results/{wildcards.run}/train/homing/final.pt"
     return selected_policy(wildcards)
 
 
@@ -72,19 +88,20 @@ def panel_of(wildcards):
     """The registered panel named by the wildcards; an unknown one is one clear error."""
     key = f"{wildcards.figure}/{wildcards.panel}"
     if key not in PANELS:
-        raise WorkflowError(f"unknown panel {key!r}: choose one of {', '.join(PANELS)}")
+        fail(f"unknown panel {key!r}: choose one of {', '.join(PANELS)}")
     return PANELS[key]
 
 
 def all_targets():
-    """Every final output of the pipeline at the chosen scale."""
+    """Every final output of the pipeline for this run."""
     targets = [
-        f"results/{SCALE}/bench/bench_physics.json",
-        f"results/{SCALE}/bench/bench_accuracy.parquet",
-        f"figures/{SCALE}/bench/bench_accuracy.png",
+        f"results/{RUN}/bench/bench_physics.json",
+        f"results/{RUN}/bench/bench_accuracy.parquet",
+        f"figures/{RUN}/bench/bench_accuracy.png",
+        f"figures/{RUN}/bench/bench_accuracy.pdf",
     ]
-    targets += [f"results/{SCALE}/assays/{a}/{t}.parquet" for a in ASSAYS for t in ("steps", "episodes", "food")]
-    targets += [f"figures/{SCALE}/{p.figure}/{p.name}.{ext}" for p in DRAWABLE for ext in ("png", "pdf")]
+    targets += [f"results/{RUN}/assays/{a}/{t}.parquet" for a in ASSAYS for t in ("steps", "episodes", "food")]
+    targets += [f"figures/{RUN}/{p.figure}/{p.name}.{ext}" for p in DRAWABLE for ext in ("png", "pdf")]
     pages = {p.figure for p in DRAWABLE}
-    targets += [f"figures/{SCALE}/{fig}.{ext}" for fig in sorted(pages) for ext in ("png", "pdf")]
+    targets += [f"figures/{RUN}/{fig}.{ext}" for fig in sorted(pages) for ext in ("png", "pdf")]
     return targets

@@ -6,15 +6,15 @@ rule panel:
         lambda w: panel_inputs(panel_of(w)),
     output:
         png=report(
-            "figures/{scale}/{figure}/{panel}.png",
+            "figures/{run}/{figure}/{panel}.png",
             caption="../report/panel.rst",
             category="{figure}",
         ),
-        pdf="figures/{scale}/{figure}/{panel}.pdf",
+        pdf="figures/{run}/{figure}/{panel}.pdf",
     log:
-        "results/{scale}/logs/figures/{figure}_{panel}.log",
+        "results/{run}/logs/figures/{figure}_{panel}.log",
     benchmark:
-        "results/{scale}/benchmarks/figures/{figure}_{panel}.tsv"
+        "results/{run}/benchmarks/figures/{figure}_{panel}.tsv"
     params:
         overrides=ARGS,
         caption=lambda w: panel_of(w).caption,
@@ -24,20 +24,20 @@ rule panel:
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish figure {wildcards.figure}/{wildcards.panel} scale={wildcards.scale} {params.overrides} "
-        "--results results/{wildcards.scale} --out {params.out} > {log} 2>&1"
+        "efish figure {wildcards.figure}/{wildcards.panel} {params.overrides} "
+        "--results results/{wildcards.run} --out {params.out} > {log} 2>&1"
 
 
 rule figure_page:
     input:
         lambda w: [path for p in DRAWABLE if p.figure == w.figure for path in panel_inputs(p)],
     output:
-        png="figures/{scale}/{figure}.png",
-        pdf="figures/{scale}/{figure}.pdf",
+        png="figures/{run}/{figure}.png",
+        pdf="figures/{run}/{figure}.pdf",
     log:
-        "results/{scale}/logs/figures/{figure}.log",
+        "results/{run}/logs/figures/{figure}.log",
     benchmark:
-        "results/{scale}/benchmarks/figures/{figure}.tsv"
+        "results/{run}/benchmarks/figures/{figure}.tsv"
     params:
         overrides=ARGS,
         out=folder_of("png"),
@@ -46,5 +46,5 @@ rule figure_page:
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish figure {wildcards.figure} scale={wildcards.scale} {params.overrides} "
-        "--results results/{wildcards.scale} --out {params.out} > {log} 2>&1"
+        "efish figure {wildcards.figure} {params.overrides} "
+        "--results results/{wildcards.run} --out {params.out} > {log} 2>&1"

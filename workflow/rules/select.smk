@@ -4,15 +4,15 @@
 
 rule evaluate_seed:
     input:
-        "results/{scale}/train/seed_{seed}/final.pt",
+        "results/{run}/train/seed_{seed}/final.pt",
     output:
-        "results/{scale}/selection/seed_{seed}/episodes.parquet",
-        "results/{scale}/selection/seed_{seed}/steps.parquet",
-        "results/{scale}/selection/seed_{seed}/food.parquet",
+        "results/{run}/selection/seed_{seed}/episodes.parquet",
+        "results/{run}/selection/seed_{seed}/steps.parquet",
+        "results/{run}/selection/seed_{seed}/food.parquet",
     log:
-        "results/{scale}/logs/selection/seed_{seed}.log",
+        "results/{run}/logs/selection/seed_{seed}.log",
     benchmark:
-        "results/{scale}/benchmarks/selection/seed_{seed}.tsv"
+        "results/{run}/benchmarks/selection/seed_{seed}.tsv"
     params:
         overrides=ARGS,
         out=folder_of(0),
@@ -20,24 +20,24 @@ rule evaluate_seed:
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish assay assay=selection scale={wildcards.scale} {params.overrides} --policy {input} "
+        "efish assay assay=selection {params.overrides} --policy {input} "
         "--out {params.out} > {log} 2>&1"
 
 
 checkpoint select_seed:
     input:
-        expand("results/{{scale}}/selection/seed_{seed}/episodes.parquet", seed=SEEDS),
+        expand("results/{{run}}/selection/seed_{seed}/episodes.parquet", seed=SEEDS),
     output:
-        ranking="results/{scale}/analysis/selection/ranking.parquet",
-        seed="results/{scale}/analysis/selection/selected_seed.txt",
+        ranking="results/{run}/analysis/selection/ranking.parquet",
+        seed="results/{run}/analysis/selection/selected_seed.txt",
     log:
-        "results/{scale}/logs/select_seed.log",
+        "results/{run}/logs/select_seed.log",
     benchmark:
-        "results/{scale}/benchmarks/select_seed.tsv"
+        "results/{run}/benchmarks/select_seed.tsv"
     params:
         overrides=ARGS,
         out=folder_of("ranking"),
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish select scale={wildcards.scale} {params.overrides} --episodes {input} --out {params.out} > {log} 2>&1"
+        "efish select {params.overrides} --episodes {input} --out {params.out} > {log} 2>&1"

@@ -6,12 +6,12 @@
 
 rule train:
     output:
-        final="results/{scale}/train/seed_{seed}/final.pt",
-        metrics="results/{scale}/train/seed_{seed}/metrics.parquet",
+        final="results/{run}/train/seed_{seed}/final.pt",
+        metrics="results/{run}/train/seed_{seed}/metrics.parquet",
     log:
-        "results/{scale}/logs/train/seed_{seed}.log",
+        "results/{run}/logs/train/seed_{seed}.log",
     benchmark:
-        "results/{scale}/benchmarks/train/seed_{seed}.tsv"
+        "results/{run}/benchmarks/train/seed_{seed}.tsv"
     params:
         overrides=ARGS,
         out=folder_of("final"),
@@ -19,18 +19,18 @@ rule train:
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish train scale={wildcards.scale} train.seed={wildcards.seed} train.threads={threads} "
+        "efish train train.seed={wildcards.seed} train.threads={threads} "
         "{params.overrides} --out {params.out} > {log} 2>&1"
 
 
 rule train_homing:
     output:
-        final="results/{scale}/train/homing/final.pt",
-        metrics="results/{scale}/train/homing/metrics.parquet",
+        final="results/{run}/train/homing/final.pt",
+        metrics="results/{run}/train/homing/metrics.parquet",
     log:
-        "results/{scale}/logs/train/homing.log",
+        "results/{run}/logs/train/homing.log",
     benchmark:
-        "results/{scale}/benchmarks/train/homing.tsv"
+        "results/{run}/benchmarks/train/homing.tsv"
     params:
         overrides=ARGS,
         out=folder_of("final"),
@@ -38,5 +38,5 @@ rule train_homing:
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish train scale={wildcards.scale} policy=homing train.threads={threads} "
+        "efish train policy=homing train.threads={threads} "
         "{params.overrides} --out {params.out} > {log} 2>&1"

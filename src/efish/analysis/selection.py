@@ -16,6 +16,8 @@ from typing import Iterable
 import numpy as np
 import pandas as pd
 
+from ..io import read_parquet
+
 
 def ols_fit(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
     """(slope, intercept, R^2) of y ~ x; R^2 is 0 when y does not vary, NaN slope when x does not."""
@@ -81,12 +83,7 @@ def read_seed_episodes(paths: Iterable[str | Path]) -> pd.DataFrame:
         m = re.search(r"seed_(\d+)", str(path))
         if not m:
             raise ValueError(f"cannot tell the seed of {path}: put it under a folder named seed_<n>")
-        try:
-            frames.append(pd.read_parquet(path).assign(seed=int(m.group(1))))
-        except OSError:
-            raise
-        except Exception as exc:  # pyarrow raises its own types for files that are not Parquet
-            raise ValueError(f"cannot read {path} as an episodes table: {type(exc).__name__}") from None
+        frames.append(read_parquet(path, "an episodes table").assign(seed=int(m.group(1))))
     if not frames:
         raise ValueError("no episodes tables given")
     return pd.concat(frames, ignore_index=True)

@@ -1,6 +1,6 @@
 """Typed, validated configuration composed with Hydra."""
 
-from .compose import compose, config_dir, to_yaml
+from .compose import compose, config_dir, run_name, to_yaml
 from .schema import (
     ConfigError,
     EfishConfig,
@@ -16,6 +16,7 @@ __all__ = [
     "SensorsConfig",
     "compose",
     "config_dir",
+    "run_name",
     "to_yaml",
     "validate",
 ]

@@ -7,6 +7,7 @@ one line naming the key.
 
 from __future__ import annotations
 
+import hashlib
 import os
 import re
 from pathlib import Path
@@ -97,6 +98,19 @@ def one_line_message(exc: BaseException) -> str:
         detail = next((ln for ln in lines if "Value" in ln or "type" in ln.lower()), lines[0])
         return f"bad value for '{name.group(1)}': {detail}"
     return lines[0] if lines else type(exc).__name__
+
+
+def run_name(scale: str, overrides: Sequence[str]) -> str:
+    """The name of a run's folders under ``results/`` and ``figures/``: the scale as shipped, else the scale and a
+    short hash of the sorted overrides, so that two configs never share a folder.
+
+    >>> run_name("laptop", []), run_name("laptop", ["train.lr=3e-4", "physics.tolerance=1e-6"])
+    ('laptop', 'laptop-453280a3')
+    """
+    if not overrides:
+        return scale
+    digest = hashlib.sha256("\n".join(sorted(overrides)).encode()).hexdigest()[:8]
+    return f"{scale}-{digest}"
 
 
 def to_yaml(cfg: EfishConfig) -> str:

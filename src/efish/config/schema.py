@@ -18,9 +18,14 @@ class ConfigError(ValueError):
 
 
 def param(default: Any, doc: str, *, lo: float | None = None, hi: float | None = None,
-          choices: tuple | None = None) -> Any:
-    """Declare a config field with a one-line doc and an optional allowed range."""
-    meta = {"doc": doc, "lo": lo, "hi": hi, "choices": choices}
+          choices: tuple | None = None, neutral: bool = False) -> Any:
+    """Declare a config field with a one-line doc and an optional allowed range.
+
+    ``neutral``: the value cannot change a training result (threads, how often
+    to checkpoint, how far to train), so a checkpoint written under another
+    value may be resumed (see :func:`result_neutral_keys`).
+    """
+    meta = {"doc": doc, "lo": lo, "hi": hi, "choices": choices, "neutral": neutral}
     if isinstance(default, (list, dict)):
         return field(default_factory=lambda: type(default)(default), metadata=meta)
     return field(default=default, metadata=meta)
@@ -224,9 +229,10 @@ class TrainConfig:
     num_envs: int = param(16, "parallel arenas per rollout", lo=1)
     rollout_steps: int = param(1600, "steps per rollout", lo=1)
     chunk: int = param(100, "BPTT chunk length; must divide rollout_steps", lo=1)
-    total_steps: int = param(5_000_000, "env steps per seed (arena steps x arenas)", lo=1)
-    checkpoint_every: int = param(10, "updates between checkpoints", lo=1)
-    threads: int = param(1, "torch threads", lo=1, hi=256)
+    total_steps: int = param(5_000_000, "env steps per seed (arena steps x arenas); a longer run resumes a shorter "
+                                        "one's checkpoint", lo=1, neutral=True)
+    checkpoint_every: int = param(10, "updates between checkpoints", lo=1, neutral=True)
+    threads: int = param(1, "torch threads", lo=1, hi=256, neutral=True)
     bf16: bool = param(False, "bf16 autocast of forward passes (CPUs with bf16 support)")
     seed: int = param(1, "training seed", lo=0)
 
@@ -293,6 +299,44 @@ class EfishConfig:
     assay: AssayConfig = group(AssayConfig)
     bench: BenchConfig = group(BenchConfig)
     scale: ScaleConfig = group(ScaleConfig)
+
+
+# Groups whose values a training run depends on; the rest (assay, bench, scale) only name or size other jobs,
+# and what the scale sets for training reaches it through train.* (resolved).
+TRAINING_GROUPS = ("physics", "sensors", "arena", "env", "train")
+
+
+def result_neutral_keys(cfg: Any = None, path: str = "") -> set[str]:
+    """Dotted keys declared ``neutral`` in the schema: a checkpoint written under other values still resumes."""
+    cfg = cfg if cfg is not None else EfishConfig()
+    keys = set()
+    for f in dataclasses.fields(cfg):
+        value = getattr(cfg, f.name)
+        if dataclasses.is_dataclass(value):
+            keys |= result_neutral_keys(value, f"{path}{f.name}.")
+        elif f.metadata.get("neutral"):
+            keys.add(f"{path}{f.name}")
+    return keys
+
+
+def training_config(cfg: "EfishConfig") -> dict:
+    """The resolved values a training run depends on, as a plain nested dict (what a checkpoint records)."""
+    return {g: dataclasses.asdict(getattr(cfg, g)) for g in TRAINING_GROUPS}
+
+
+def config_differences(a: dict, b: dict, ignore: set[str] = frozenset(), path: str = "") -> list[str]:
+    """Dotted keys whose values differ between two nested dicts (missing on one side counts), minus ``ignore``."""
+    keys = []
+    for k in sorted(set(a) | set(b)):
+        key = f"{path}{k}"
+        va, vb = a.get(k), b.get(k)
+        if key in ignore:
+            continue
+        if isinstance(va, dict) and isinstance(vb, dict):
+            keys += config_differences(va, vb, ignore, key + ".")
+        elif va != vb or (k in a) != (k in b):
+            keys.append(key)
+    return keys
 
 
 # ------------------------------------------------------------------ validation

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from ..io import atomic_path
+from ..io import atomic_path, read_parquet
 from .registry import PANELS, Panel
 from .style import panel_style
 
@@ -28,7 +28,7 @@ def load_tables(panel: Panel, results: Path, seeds: int) -> dict[str, pd.DataFra
         for seed, path in enumerate(paths, 1):
             if not path.is_file():
                 raise ValueError(f"panel {panel.key} needs {path}, which does not exist (run the pipeline first)")
-            frame = pd.read_parquet(path)
+            frame = read_parquet(path)
             frames.append(frame.assign(seed=seed) if "{seed}" in panel.inputs[name] else frame)
         tables[name] = pd.concat(frames, ignore_index=True)
     return tables

@@ -18,9 +18,9 @@ import numpy as np
 import pandas as pd
 import torch
 
-from ..config.schema import EfishConfig
+from ..config.schema import EfishConfig, config_differences, result_neutral_keys, training_config
 from ..env.vec_env import VecEnv
-from ..io import atomic_path
+from ..io import atomic_path, remove_partial_writes
 from ..physics.geometry import conspecific_slots
 from .advantages import gae
 from .mappo import Rollout, ppo_update
@@ -118,29 +118,40 @@ def collect(cfg: EfishConfig, env: VecEnv, learner: Learner, carry: dict, genera
                  advantages=adv, returns=ret, starts=data["starts"], h_actor=torch.stack(h_actor_chunks),
                  h_critic=torch.stack(h_critic_chunks))
     episode = {"episode_return": float(np.mean(returns_done)) if returns_done else float("nan"),
+               "episodes_ended": len(returns_done),
                **{f"reward_{k}": v / T for k, v in parts.items()}}
     return ro, episode
 
 
-def train(cfg: EfishConfig, out_dir: str | Path, progress=None) -> pd.DataFrame:
-    """Train one seed into ``out_dir`` (checkpoint.pt, metrics.parquet, and final.pt at the end); resumes from a
-    checkpoint there."""
+def train(cfg: EfishConfig, out_dir: str | Path, progress=None, restart: bool = False) -> pd.DataFrame:
+    """Train one seed into ``out_dir`` (checkpoint.pt, metrics.parquet, and final.pt at the end).
+
+    Resumes from a checkpoint there only when it was written under the same
+    config (apart from the schema's result-neutral keys: threads, checkpoint
+    interval, a longer ``total_steps``); any other difference is one clear
+    error. ``restart`` discards the folder's checkpoint and starts afresh. A
+    finished run is written out again (final.pt, metrics.parquet) without
+    further updates.
+    """
     out = Path(out_dir)
     t_cfg = cfg.train
     torch.set_num_threads(t_cfg.threads)
     env = VecEnv(cfg, num_envs=t_cfg.num_envs, seed=t_cfg.seed)
     obs = env.reset()  # bad env settings fail here, before anything is written
-    out.mkdir(parents=True, exist_ok=True)
     learner = Learner(cfg, obs.shape[-1], env.n)
     carry = initial_carry(obs, t_cfg.hidden)
     generator = torch.Generator().manual_seed(t_cfg.seed)
-    rows, update = [], 0
-    if (out / CHECKPOINT).exists():
-        update, rows = load_checkpoint(out / CHECKPOINT, learner, env, carry, generator)
-        LOG.info("resumed from %s at update %d (%d env steps)", out / CHECKPOINT, update,
-                 update * t_cfg.rollout_steps * t_cfg.num_envs)
     steps_per_update = t_cfg.rollout_steps * t_cfg.num_envs
     total_updates = max(1, t_cfg.total_steps // steps_per_update)
+    rows, update = [], 0
+    remove_partial_writes(out)  # temporaries of a killed run
+    if restart:
+        for name in (CHECKPOINT, FINAL, METRICS):
+            (out / name).unlink(missing_ok=True)
+    if (out / CHECKPOINT).exists():
+        update, rows = load_checkpoint(out / CHECKPOINT, cfg, learner, env, carry, generator, total_updates)
+        LOG.info("resumed from %s at update %d (%d env steps)", out / CHECKPOINT, update, update * steps_per_update)
+    out.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
     while update < total_updates:
         t0 = time.perf_counter()
@@ -154,21 +165,27 @@ def train(cfg: EfishConfig, out_dir: str | Path, progress=None) -> pd.DataFrame:
         if progress:
             progress(rows[-1], total_updates)
         if update % t_cfg.checkpoint_every == 0 or update == total_updates:
-            save_checkpoint(out / CHECKPOINT, learner, env, carry, generator, update, rows)
-            with atomic_path(out / METRICS) as tmp:
-                pd.DataFrame(rows).to_parquet(tmp, index=False)
-    # Written once, atomically, after the last update: a killed job never leaves a final.pt, so the
-    # workflow reruns it and the rerun resumes from checkpoint.pt instead of starting over.
+            save_checkpoint(out / CHECKPOINT, cfg, learner, env, carry, generator, update, rows)
+            write_metrics(out / METRICS, rows)
+    # Written at the end, atomically: a killed job never leaves a final.pt, so the workflow reruns it and the
+    # rerun resumes from checkpoint.pt; a finished run rerun with its config writes both outputs again.
+    write_metrics(out / METRICS, rows)
     with atomic_path(out / FINAL) as tmp:
         shutil.copyfile(out / CHECKPOINT, tmp)
     return pd.DataFrame(rows)
 
 
-def save_checkpoint(path: Path, learner: Learner, env: VecEnv, carry: dict, generator: torch.Generator,
-                    update: int, rows: list[dict]) -> None:
-    """Everything a resumed run needs to continue bit for bit, written atomically."""
+def write_metrics(path: Path, rows: list[dict]) -> None:
+    """The metrics table, one row per update, written atomically."""
+    with atomic_path(path) as tmp:
+        pd.DataFrame(rows).to_parquet(tmp, index=False)
+
+
+def save_checkpoint(path: Path, cfg: EfishConfig, learner: Learner, env: VecEnv, carry: dict,
+                    generator: torch.Generator, update: int, rows: list[dict]) -> None:
+    """Everything a resumed run needs to continue bit for bit, and the config it ran under, written atomically."""
     state = {
-        "architecture": learner.architecture, "update": update, "metrics": rows,
+        "architecture": learner.architecture, "config": training_config(cfg), "update": update, "metrics": rows,
         "actor": learner.actor.state_dict(), "critic": learner.critic.state_dict(),
         "value_norm": learner.value_norm.state_dict(),
         "actor_opt": learner.actor_opt.state_dict(), "critic_opt": learner.critic_opt.state_dict(),
@@ -179,13 +196,22 @@ def save_checkpoint(path: Path, learner: Learner, env: VecEnv, carry: dict, gene
         torch.save(state, tmp)
 
 
-def load_checkpoint(path: Path, learner: Learner, env: VecEnv, carry: dict, generator: torch.Generator
-                    ) -> tuple[int, list[dict]]:
-    """Restore a checkpoint into live objects; one clear error if it does not fit."""
+def load_checkpoint(path: Path, cfg: EfishConfig, learner: Learner, env: VecEnv, carry: dict,
+                    generator: torch.Generator, total_updates: int) -> tuple[int, list[dict]]:
+    """Restore a checkpoint into live objects; one clear error if it does not fit this config."""
     try:
         state = torch.load(path, weights_only=False)
-    except Exception as exc:  # truncated or foreign file
-        raise ValueError(f"cannot read checkpoint {path}: {type(exc).__name__}") from None
+        recorded = state["config"]
+    except Exception as exc:  # truncated, foreign, or from before configs were recorded
+        raise ValueError(f"cannot read checkpoint {path} ({type(exc).__name__}): delete it, or run again with "
+                         "--restart to start afresh") from None
+    differ = config_differences(recorded, training_config(cfg), result_neutral_keys())
+    if differ:
+        raise ValueError(f"checkpoint {path} was written under another config ({', '.join(differ)} differ): run "
+                         "again with --restart to start afresh, or use another --out")
+    if state["update"] > total_updates:
+        raise ValueError(f"checkpoint {path} is at update {state['update']}, past this run's {total_updates} "
+                         "updates (train.total_steps): run again with --restart to start afresh")
     if state.get("architecture") != learner.architecture:
         raise ValueError(f"checkpoint {path} is for architecture {state.get('architecture')}, "
                          f"not {learner.architecture}")

@@ -42,6 +42,10 @@ def run_episodes(cfg: EfishConfig, policy, episodes: int, condition: str = "cont
                  deterministic: bool = True) -> dict[str, pd.DataFrame]:
     """``episodes`` episodes in parallel arenas; returns the ``steps``, ``episodes`` and ``food`` tables.
 
+    An arena is recorded up to the step its episode ends (the task's
+    termination, e.g. homing's success, or the time limit) and not after it:
+    its ``steps`` and ``return`` count only those steps.
+
     ``policy`` has ``initial_hidden(B, N)`` and ``act(obs, hidden, starts, deterministic)`` like
     :class:`efish.rl.policy.Policy`.
     """
@@ -54,27 +58,31 @@ def run_episodes(cfg: EfishConfig, policy, episodes: int, condition: str = "cont
     electric = cfg.sensors.perception == "electric"
     food = FoodLog(env)
     steps, bites_recv = [], np.zeros((B, N), int)
+    running = np.ones(B, bool)  # arenas whose episode has not ended: only they are recorded
     for t in range(T):
         actions, hidden = policy.act(obs, hidden, starts, deterministic)
         alive_before = env.state.alive.copy()
         obs, reward, term, trunc, info = env.step(actions)
-        food.update(env, alive_before, t)
+        food.update(env, alive_before, t, running)
+        success = env.task.success(env.state)
         row = {
             "episode": np.repeat(np.arange(B), N), "t": np.full(B * N, t), "agent": np.tile(np.arange(N), B),
             "x_cm": env.state.xy[..., 0].ravel(), "y_cm": env.state.xy[..., 1].ravel(),
-            "heading_rad": env.state.heading.ravel(), "size": env.state.size.ravel(), "move": info["move"].ravel(), "turn": info["turn"].ravel(),
-            "eod": info["eod"].ravel(), "bite": info["bite"].ravel(), "ate": info["ate"].ravel(),
-            "bit": info["bit"].ravel(), "was_bitten": info["was_bitten"].ravel(),
+            "heading_rad": env.state.heading.ravel(), "size": env.state.size.ravel(), "move": info["move"].ravel(),
+            "turn": info["turn"].ravel(), "eod": info["eod"].ravel(), "bite": info["bite"].ravel(),
+            "ate": info["ate"].ravel(), "bit": info["bit"].ravel(), "was_bitten": info["was_bitten"].ravel(),
             "collided": info["collided"].ravel(), "reward": reward.ravel(),
+            "terminated": np.repeat(term, N), "success": np.repeat(term & success, N),
             **{k: v.ravel() for k, v in nearest(env).items()},
             "morm_abs_mean": np.abs(obs[..., sl["mormyromast"]]).mean(-1).ravel() if electric else np.nan,
             "amp_abs_mean": np.abs(obs[..., sl["ampullary"]]).mean(-1).ravel() if electric else np.nan,
             "knollen_spikes": (obs[..., sl["knollenorgan"]] != 0).sum(-1).ravel() if electric else 0,
         }
-        steps.append(pd.DataFrame(row))
-        bites_recv += info["bitten_by"]
+        steps.append(pd.DataFrame(row)[np.repeat(running, N)])
+        bites_recv += info["bitten_by"] * running[:, None]
         starts = np.zeros(B)
-        if (term | trunc).all():
+        running &= ~(term | trunc)
+        if not running.any():
             break
     steps_df = pd.concat(steps, ignore_index=True)
     steps_df.insert(0, "condition", condition)
@@ -83,7 +91,7 @@ def run_episodes(cfg: EfishConfig, policy, episodes: int, condition: str = "cont
     episodes_df = pd.DataFrame({
         "size": g["size"].first(), "food_eaten": g["ate"].sum(), "eod_probability": g["eod"].mean(),
         "bites_given": g["bit"].sum(), "mean_nn_dist_cm": g["dist_agent_cm"].mean(), "return": g["reward"].sum(),
-        "steps": g["t"].count()}).reset_index()
+        "steps": g["t"].count(), "terminated": g["terminated"].any(), "success": g["success"].any()}).reset_index()
     episodes_df["bites_received"] = bites_recv[episodes_df["episode"], episodes_df["agent"]]
     episodes_df.insert(0, "condition", condition)
     food_df = food.table()
@@ -110,9 +118,11 @@ class FoodLog:
         self.records.append([b, self.count[b], env.state.pellet_xy[b, k, 0], env.state.pellet_xy[b, k, 1], t, -1])
         self.count[b] += 1
 
-    def update(self, env: VecEnv, alive_before: np.ndarray, t: int) -> None:
-        """Record pellets eaten and regrown during step ``t``."""
+    def update(self, env: VecEnv, alive_before: np.ndarray, t: int, running: np.ndarray) -> None:
+        """Record pellets eaten and regrown during step ``t`` in the arenas still ``running`` (bool[B])."""
         alive = env.state.alive
+        alive_before = alive_before | ~running[:, None]  # ended arenas: nothing changes in the record
+        alive = alive | ~running[:, None]
         for b, k in zip(*np.nonzero(alive_before & ~alive)):
             self.records[self.slot[b, k]][5] = t
         for b, k in zip(*np.nonzero(~alive_before & alive)):

@@ -18,6 +18,7 @@ STEPS = pa.schema(KEYS_EPISODE + [
     ("move", pa.float32()), ("turn", pa.float32()), ("eod", pa.bool_()), ("bite", pa.bool_()),
     ("ate", pa.bool_()), ("bit", pa.bool_()), ("was_bitten", pa.bool_()), ("collided", pa.bool_()),
     ("reward", pa.float32()),
+    ("terminated", pa.bool_()), ("success", pa.bool_()),  # this step ended the episode by the task's rule / reached its goal
     ("dist_agent_cm", pa.float32()), ("bearing_agent_rad", pa.float32()),
     ("dist_food_cm", pa.float32()), ("bearing_food_rad", pa.float32()),
     ("dist_wall_cm", pa.float32()), ("bearing_wall_rad", pa.float32()),
@@ -27,7 +28,8 @@ STEPS = pa.schema(KEYS_EPISODE + [
 EPISODES = pa.schema(KEYS_EPISODE + [
     ("agent", pa.int16()), ("size", pa.float32()), ("food_eaten", pa.int32()), ("eod_probability", pa.float32()),
     ("bites_given", pa.int32()), ("bites_received", pa.int32()), ("mean_nn_dist_cm", pa.float32()),
-    ("return", pa.float32()), ("steps", pa.int32()),
+    ("return", pa.float32()), ("steps", pa.int32()),  # both up to the episode's end
+    ("terminated", pa.bool_()), ("success", pa.bool_()),
 ])
 
 FOOD = pa.schema(KEYS_EPISODE + [

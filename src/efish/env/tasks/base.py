@@ -81,3 +81,7 @@ class Task:
     def terminated(self, state: EnvState) -> np.ndarray:
         """bool[B]: arenas whose episode ends by the task's rule (the time limit is the engine's)."""
         return np.zeros(state.t.shape[0], bool)
+
+    def success(self, state: EnvState) -> np.ndarray:
+        """bool[B]: arenas whose goal is reached now; by default the task ends episodes only on success."""
+        return self.terminated(state)
