@@ -22,7 +22,8 @@ def episodes_table(seed: int = 0, n_episodes: int = 3) -> pd.DataFrame:
         for a, size in enumerate(rng.uniform(0, 1, 4)):
             rows.append({"condition": "control", "episode": e, "agent": a, "size": size,
                          "food_eaten": int(round(2 + 8 * size)), "eod_probability": 0.5, "bites_given": 0,
-                         "bites_received": 0, "mean_nn_dist_cm": 20.0, "return": 1.0, "steps": 100})
+                         "bites_received": 0, "mean_nn_dist_cm": 20.0, "return": 1.0, "steps": 100,
+                         "terminated": False, "success": False})
     return pd.DataFrame(rows)[EPISODES.names]
 
 
@@ -124,7 +125,7 @@ def test_efish_figure_writes_a_panel_with_its_config(results, tmp_path):
     assert main(["figure", "fig3/M", "scale=smoke", "--results", str(results), "--out", str(out)]) == 0
     assert (out / "fig3/M.png").is_file() and (out / "fig3/M.pdf").is_file()
     assert "name: smoke" in (out / "fig3/config.yaml").read_text()
-    assert (out / "fig3/provenance.json").is_file()
+    assert (out / "fig3/M.provenance.json").is_file()
 
 
 def test_efish_figure_rejects_an_unknown_figure_in_one_line(tmp_path, capsys):

@@ -92,7 +92,7 @@ def test_every_output_folder_has_config_and_provenance(smoke_run):
 def check_provenance(path: Path) -> None:
     prov = json.loads(path.read_text())
     assert prov["command"] and prov["finished"] >= prov["started"], path
-    assert prov["overrides"] and prov["overrides"][0] == "scale=smoke", path
+    assert "scale=smoke" in prov["overrides"], path
 
 
 @pytest.mark.slow
