@@ -84,3 +84,74 @@ def random_actions(rng: np.random.Generator, num_envs: int, n_agents: int) -> np
     """Gaussian move/turn and 0/1 eod/bite for every agent: float64[B, N, 4]."""
     return np.concatenate([rng.normal(size=(num_envs, n_agents, 2)), rng.integers(0, 2, (num_envs, n_agents, 2))],
                           axis=-1)
+
+
+def rollout_tables(seed: int = 0, conditions=("control", "treated"), episodes: int = 3, n_agents: int = 4,
+                   steps: int = 120, units: int = 8, bite_target: bool = True, error_angles: bool = False,
+                   arena_cm: float = 70.0) -> dict:
+    """Synthetic rollout tables with the columns of ``efish.rollout.schema`` (steps, episodes, food), a
+    ``hidden`` table keyed like steps (``h_0 .. h_{units-1}``) and, by choice, the columns the assays issue adds
+    (``bite_target``; ``err_*_rad``). Agents random-walk in the middle 30 cm so that pairs meet, bite and
+    chase; bigger agents discharge and eat more, so that size effects exist."""
+    import pandas as pd
+
+    rng = np.random.default_rng(seed)
+    frames, hidden, food = [], [], []
+    for cond in conditions:
+        for e in range(episodes):
+            frames.append(_episode_steps(rng, cond, e, n_agents, steps, arena_cm))
+            latent = np.cumsum(rng.normal(size=(steps * n_agents, 3)), axis=0)
+            h = latent @ rng.normal(size=(3, units)) + 0.1 * rng.normal(size=(steps * n_agents, units))
+            hidden.append(frames[-1][["condition", "episode", "t", "agent"]].assign(
+                **{f"h_{i}": h[:, i].astype(np.float32) for i in range(units)}))
+            food.append(pd.DataFrame({"condition": cond, "episode": e, "pellet": np.arange(5),
+                                      "x_cm": rng.uniform(0, arena_cm, 5), "y_cm": rng.uniform(0, arena_cm, 5),
+                                      "t_spawned": 0, "t_eaten": -1}))
+    s = pd.concat(frames, ignore_index=True)
+    if not bite_target:
+        s = s.drop(columns="bite_target")
+    if error_angles:
+        s = s.assign(**{c: rng.vonmises(0.0, 2.0, len(s)) for c in ("err_morm_rad", "err_amp_rad", "err_knollen_rad")})
+    return {"steps": s, "episodes": _episodes_of(s), "food": pd.concat(food, ignore_index=True),
+            "hidden": pd.concat(hidden, ignore_index=True)}
+
+
+def _episode_steps(rng, cond: str, episode: int, n: int, steps: int, arena_cm: float):
+    """Steps of one episode: (t, agent) rows, t-major, with every steps column of the rollout schema."""
+    import pandas as pd
+
+    size = rng.uniform(0, 1, n)
+    centre = arena_cm / 2
+    xy = np.clip(centre + np.cumsum(rng.normal(0, 1.0, (steps, n, 2)), axis=0), centre - 15, centre + 15)
+    d = np.linalg.norm(xy[:, :, None] - xy[:, None], axis=-1) + np.where(np.eye(n, dtype=bool), np.inf, 0)
+    nearest = d.argmin(axis=-1)
+    bit = (d.min(axis=-1) < 5) & (rng.random((steps, n)) < 0.2 + 0.3 * size)
+    was_bitten = np.zeros((steps, n), bool)
+    for t, i in zip(*np.nonzero(bit), strict=True):
+        was_bitten[t, nearest[t, i]] = True
+    wall = np.minimum(xy, arena_cm - xy).min(axis=-1)
+    cols = {"heading_rad": rng.uniform(-np.pi, np.pi, (steps, n)), "size": np.broadcast_to(size, (steps, n)),
+            "move": rng.uniform(-1, 1, (steps, n)), "turn": rng.uniform(-1, 1, (steps, n)),
+            "eod": rng.random((steps, n)) < 0.1 + 0.5 * size, "bite": bit | (rng.random((steps, n)) < 0.05),
+            "ate": rng.random((steps, n)) < 0.02 + 0.1 * size, "bit": bit, "was_bitten": was_bitten,
+            "collided": np.zeros((steps, n), bool), "reward": rng.normal(size=(steps, n)),
+            "terminated": np.zeros((steps, n), bool), "success": np.zeros((steps, n), bool),
+            "dist_agent_cm": d.min(axis=-1), "bearing_agent_rad": rng.uniform(-np.pi, np.pi, (steps, n)),
+            "dist_food_cm": rng.uniform(0, 12, (steps, n)), "bearing_food_rad": rng.uniform(-np.pi, np.pi, (steps, n)),
+            "dist_wall_cm": wall, "bearing_wall_rad": rng.uniform(-np.pi, np.pi, (steps, n)),
+            "morm_abs_mean": rng.random((steps, n)), "amp_abs_mean": rng.random((steps, n)),
+            "knollen_spikes": rng.integers(0, 12, (steps, n)), "bite_target": np.where(bit, nearest, -1)}
+    t, agent = np.repeat(np.arange(steps), n), np.tile(np.arange(n), steps)
+    return pd.DataFrame({"condition": cond, "episode": episode, "t": t, "t_ms": t * 1000.0 / 83.0, "agent": agent,
+                         "x_cm": xy[..., 0].ravel(), "y_cm": xy[..., 1].ravel(),
+                         **{k: np.asarray(v).ravel() for k, v in cols.items()}})
+
+
+def _episodes_of(steps):
+    """The episodes table (one row per agent-episode) that goes with a steps table."""
+    g = steps.groupby(["condition", "episode", "agent"], sort=True)
+    out = g.agg(size=("size", "first"), food_eaten=("ate", "sum"), eod_probability=("eod", "mean"),
+                bites_given=("bit", "sum"), bites_received=("was_bitten", "sum"),
+                mean_nn_dist_cm=("dist_agent_cm", "mean"), **{"return": ("reward", "sum")}, steps=("t", "size"),
+                terminated=("terminated", "any"), success=("success", "any"))
+    return out.reset_index()

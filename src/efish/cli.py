@@ -5,6 +5,7 @@
     efish train [overrides] [--out D]         train one seed (checkpoint.pt, metrics.parquet, final.pt)
     efish assay [overrides] --policy P        run an assay into steps/episodes/food.parquet
     efish select --episodes F... --out D      rank seeds, write the ranking and the chosen seed
+    efish analyze NAME [overrides] --tables D --out D   one analysis of an assay's tables -> <table>.parquet
     efish figure FIG[/PANEL] [overrides]      draw a panel (or a figure's page) from the result tables
     efish bench physics [overrides] [--json]  sensing throughput, fast vs reference
     efish bench accuracy [overrides] --out D  accuracy-vs-time study -> table + figure
@@ -51,6 +52,11 @@ def _parser() -> argparse.ArgumentParser:
     sel.add_argument("--episodes", nargs="+", type=Path, required=True,
                      help="episodes.parquet files in folders named seed_<n>")
     sel.add_argument("--out", type=Path, required=True, help="folder for ranking.parquet and selected_seed.txt")
+    an = sub.add_parser("analyze", help="run one analysis (efish.analysis.registry) on an assay's rollout tables")
+    an.add_argument("name", help="an analysis of efish.analysis.registry, e.g. behaviour (a wrong name lists them)")
+    an.add_argument("overrides", nargs="*", help="config overrides, e.g. assay=patchy4 analysis.rate_bins=10")
+    an.add_argument("--tables", type=Path, required=True, help="folder of the assay's tables (steps.parquet, ...)")
+    an.add_argument("--out", type=Path, required=True, help="folder for <table>.parquet, config.yaml, provenance.json")
     fg = sub.add_parser("figure", help="draw a panel (fig3/M) or a whole figure's page (fig3) from the tables")
     fg.add_argument("key", help="panel id like fig3/M, or a figure id like fig3 for its page")
     fg.add_argument("overrides", nargs="*")
@@ -181,6 +187,16 @@ def _select(args, cfg, started) -> None:
     print(f"selected seed {chosen}")
 
 
+def _analyze(args, cfg, started) -> None:
+    from .analysis.registry import read_tables, run
+    from .io import write_parquet_tables
+
+    result = run(args.name, read_tables(args.name, args.tables), cfg)  # everything is read before anything is written
+    write_parquet_tables(result, args.out)
+    _metadata(args.out, cfg, started, args, analysis=args.name, tables=str(args.tables))
+    print(f"wrote {', '.join(f'{k}.parquet ({len(v)} rows)' for k, v in result.items())} to {args.out}")
+
+
 def _figure(args, cfg, started) -> None:
     from .figures.registry import figures, panels_for
     from .figures.render import render_page, render_panel
@@ -267,6 +283,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             _train(args, cfg, started)
         elif args.command == "assay":
             _assay(args, cfg, started)
+        elif args.command == "analyze":
+            _analyze(args, cfg, started)
         elif args.command == "figure":
             _figure(args, cfg, started)
         elif args.command == "plan":

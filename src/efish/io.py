@@ -9,11 +9,11 @@ import re
 import subprocess
 import sys
 import tempfile
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager
 from datetime import datetime, timezone
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
-from typing import Iterator
+from typing import Any, Iterator
 
 _PARTIAL = re.compile(r"^\..+\.[a-z0-9_]{8}(\.[A-Za-z0-9]+)?$")  # tempfile.mkstemp names of atomic_path
 PROVENANCE_PACKAGES = ("numpy", "numba", "pandas", "pyarrow", "hydra-core", "omegaconf", "matplotlib", "torch")
@@ -38,6 +38,29 @@ def atomic_path(path: str | os.PathLike, commit: bool = True) -> Iterator[Path]:
     finally:
         if tmp_path.exists():
             tmp_path.unlink()
+
+
+def write_parquet_tables(tables: dict[str, Any], folder: str | os.PathLike) -> list[Path]:
+    """``<folder>/<name>.parquet`` for every table (a pandas DataFrame or a pyarrow Table), all or none.
+
+    Every table is written to a temporary file first, and only when all writes
+    succeeded are they renamed into place: a failing write (a full disk) leaves
+    the folder as it was, never a half-written table nor a new table beside old ones.
+    """
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    folder = Path(folder)
+    with ExitStack() as stack:
+        staged = {}
+        for name, table in tables.items():
+            tmp = stack.enter_context(atomic_path(folder / f"{name}.parquet", commit=False))
+            arrow = table if isinstance(table, pa.Table) else pa.Table.from_pandas(table, preserve_index=False)
+            pq.write_table(arrow, tmp)
+            staged[name] = tmp
+        for name, tmp in staged.items():
+            os.replace(tmp, folder / f"{name}.parquet")
+    return [folder / f"{name}.parquet" for name in tables]
 
 
 def read_parquet(path: str | os.PathLike, what: str = "a table"):

@@ -6,7 +6,8 @@ import pytest
 
 from efish.config import ConfigError, EfishConfig, compose, config_dir, to_yaml, validate
 from efish.config.schema import (
-    ArenaConfig, AssayConfig, BenchConfig, EnvConfig, PhysicsConfig, ScaleConfig, SensorsConfig, TrainConfig,
+    AnalysisConfig, ArenaConfig, AssayConfig, BenchConfig, EnvConfig, PhysicsConfig, ScaleConfig, SensorsConfig,
+    TrainConfig,
 )
 
 from ..helpers import cfg_with
@@ -120,7 +121,8 @@ def test_config_error_is_a_value_error():
 
 
 GROUPS = {"physics": PhysicsConfig, "sensors": SensorsConfig, "arena": ArenaConfig, "env": EnvConfig,
-          "train": TrainConfig, "assay": AssayConfig, "bench": BenchConfig, "scale": ScaleConfig}
+          "train": TrainConfig, "assay": AssayConfig, "bench": BenchConfig, "scale": ScaleConfig,
+          "analysis": AnalysisConfig}
 
 
 def _leaves(node, prefix=""):

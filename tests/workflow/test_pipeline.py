@@ -51,7 +51,8 @@ def test_every_declared_output_exists(smoke_run):
     outputs = declared_outputs(smoke_run)
     for part in ("train/seed_1/final.pt", "train/seed_2/final.pt", "train/homing/final.pt",
                  "analysis/selection/ranking.parquet", "assays/patchy4/steps.parquet",
-                 "assays/homing/episodes.parquet"):
+                 "assays/homing/episodes.parquet", "analysis/behaviour/patchy4/condition_tests.parquet",
+                 "analysis/homing/homing/perception.parquet"):
         assert f"results/smoke/{part}" in outputs, part
     assert any(o.startswith("figures/smoke/fig3/") for o in outputs)
     missing = [o for o in outputs if not (smoke_run / o).is_file()]

@@ -5,6 +5,7 @@ import shlex
 import sys
 from pathlib import Path
 
+from efish.analysis.registry import ANALYSES, analyses_for, tables_written
 from efish.config import ConfigError, compose, run_name
 from efish.figures.registry import PANELS, panels_for
 from efish.figures.render import input_paths
@@ -50,6 +51,8 @@ def assay_config(name):
 
 
 ASSAYS = [assay_config(name).assay.name for name in CFG.scale.assays]
+# The analyses of each assay of the scale whose tables it writes (dynamics waits for assay.record_hidden).
+ASSAY_ANALYSES = {name: analyses_for(name, tables_written(assay_config(name).assay)) for name in ASSAYS}
 DRAWABLE = panels_for(ASSAYS)
 
 
@@ -63,6 +66,16 @@ def folder_of(name, up=0):
     """A params function: the folder of output ``name`` (a name or an index), or the folder ``up`` levels
     above it. It is what efish's ``--out`` takes, so no rule repeats an output path."""
     return lambda wildcards, output: str(Path(output[name]).parents[up])
+
+
+def analysis_inputs(analysis):
+    """The rollout tables an analysis reads, by name, for the {assay} wildcard."""
+    return {t: f"results/{{run}}/assays/{{assay}}/{t}.parquet" for t in analysis.reads}
+
+
+def analysis_outputs(analysis, run="{run}", assay="{assay}"):
+    """The tables an analysis writes, by name: results/{run}/analysis/<analysis>/{assay}/<table>.parquet."""
+    return {t: f"results/{run}/analysis/{analysis.name}/{assay}/{t}.parquet" for t in analysis.outputs}
 
 
 def panel_inputs(panel):
@@ -101,6 +114,8 @@ def all_targets():
         f"figures/{RUN}/bench/bench_accuracy.pdf",
     ]
     targets += [f"results/{RUN}/assays/{a}/{t}.parquet" for a in ASSAYS for t in ("steps", "episodes", "food")]
+    targets += [path for a, analyses in ASSAY_ANALYSES.items() for an in analyses
+                for path in analysis_outputs(an, RUN, a).values()]
     targets += [f"figures/{RUN}/{p.figure}/{p.name}.{ext}" for p in DRAWABLE for ext in ("png", "pdf")]
     pages = {p.figure for p in DRAWABLE}
     targets += [f"figures/{RUN}/{fig}.{ext}" for fig in sorted(pages) for ext in ("png", "pdf")]

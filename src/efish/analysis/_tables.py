@@ -11,10 +11,15 @@ from collections.abc import Iterable
 import numpy as np
 import pandas as pd
 
-#: ms per simulation step: dt = 1/83 s (SPEC "Units"), i.e. 12.048 ms.
-STEP_MS = 1000.0 / 83.0
-#: Steps per second, the factor from an EOD probability per step to a rate in Hz.
-RATE_HZ = 83.0
+from ..config.schema import AnalysisConfig, EnvConfig
+
+#: The schema's analysis parameters (SPEC 12): the keyword defaults of the analysis functions, so that a
+#: function called by hand and ``efish analyze`` (which passes the composed config's values) agree.
+DEFAULTS = AnalysisConfig()
+#: Steps per second (``env.fps``, 83), the factor from an EOD probability per step to a rate in Hz.
+RATE_HZ = EnvConfig().fps
+#: ms per simulation step: dt = 1 / fps (SPEC "Units"), i.e. 12.048 ms.
+STEP_MS = 1000.0 / RATE_HZ
 
 EPISODE = ["condition", "episode"]
 AGENT_EPISODE = ["condition", "episode", "agent"]
@@ -43,7 +48,7 @@ def or_nan_row(frame: pd.DataFrame, reason: str) -> pd.DataFrame:
     return nan_frame(reason).reindex(columns=list(dict.fromkeys([*frame.columns, "reason"])))
 
 
-def eod_rate(steps: pd.DataFrame, window: int = 20, rate_hz: float = RATE_HZ) -> np.ndarray:
+def eod_rate(steps: pd.DataFrame, window: int = DEFAULTS.rate_window, rate_hz: float = RATE_HZ) -> np.ndarray:
     """Centred rolling mean of ``eod`` over ``window`` steps x ``rate_hz`` per agent-episode (SPEC 12), in Hz.
 
     Only full windows count, so the first and last ``window // 2`` steps of an

@@ -18,18 +18,31 @@ from sklearn.linear_model import LinearRegression
 from sklearn.metrics import r2_score
 from sklearn.model_selection import GroupKFold, cross_val_predict
 
-from ._tables import AGENT_EPISODE, RATE_HZ, require
+from ._tables import AGENT_EPISODE, DEFAULTS, EPISODE, RATE_HZ, nan_frame, require
 
-SUBSAMPLE_FRACTIONS = (0.05, 0.15, 0.25, 0.5, 0.75, 1.0)
+SUBSAMPLE_FRACTIONS = tuple(DEFAULTS.subsample_fractions)
+#: Steps columns decoded from the hidden state (SPEC 12 "Decoding", Fig 6D-F) -> circular (radians) or not. The
+#: last ones are the paper's decoding targets the rollout records from issue 13 on; a column the steps table
+#: lacks gets a row with a reason.
+DECODE_TARGETS = {"dist_agent_cm": False, "bearing_agent_rad": True, "dist_food_cm": False, "bearing_food_rad": True,
+                  "dist_wall_cm": False, "bearing_wall_rad": True, "size": False, "eod": False,
+                  "dist_agent2_cm": False, "size_agent1": False, "size_agent2": False, "n_knollen_agents": False,
+                  "food_count_5cm": False, "turn_rad": False, "log_morm_field": False, "log_amp_field": False}
+DECODE_COLUMNS = ["condition", "target", "circular", "r2", "baseline_r2", "score", "n", "n_groups", "folds", "reason"]
+
+
+def units(hidden: pd.DataFrame) -> list[str]:
+    """The unit columns ``h_0 .. h_{D-1}`` of a hidden-state frame, in unit order."""
+    found = sorted((c for c in hidden.columns if c.startswith("h_") and c[2:].isdigit()), key=lambda c: int(c[2:]))
+    if not found:
+        raise ValueError("hidden table has no h_<i> columns")
+    return found
 
 
 def hidden_matrix(hidden: pd.DataFrame) -> np.ndarray:
     """The ``h_0 .. h_{D-1}`` columns of a hidden-state frame as a T x D float64 array, rows in t order."""
-    units = sorted((c for c in hidden.columns if c.startswith("h_") and c[2:].isdigit()), key=lambda c: int(c[2:]))
-    if not units:
-        raise ValueError("hidden table has no h_<i> columns")
-    frame = hidden.sort_values("t") if "t" in hidden else hidden
-    return frame[units].to_numpy(np.float64)
+    frame = hidden.sort_values("t", kind="stable") if "t" in hidden else hidden
+    return frame[units(hidden)].to_numpy(np.float64)
 
 
 def degenerate_reason(h: np.ndarray, min_rows: int = 2) -> str:
@@ -64,7 +77,7 @@ def effective_dimensionality(h: np.ndarray) -> float:
     return float(1.0 / np.sum(lam ** 2)) if lam.size else np.nan
 
 
-def pcs_for_variance(h: np.ndarray, fraction: float = 0.9) -> float:
+def pcs_for_variance(h: np.ndarray, fraction: float = DEFAULTS.variance_fraction) -> float:
     """Fewest principal components whose variances add up to ``fraction`` (SPEC 12: 90%); NaN if degenerate."""
     lam = pca_variances(h)
     if not lam.size:
@@ -73,7 +86,7 @@ def pcs_for_variance(h: np.ndarray, fraction: float = 0.9) -> float:
     return float(np.searchsorted(np.cumsum(lam), fraction - 1e-12) + 1)
 
 
-def subsample_units(h: np.ndarray, fractions=SUBSAMPLE_FRACTIONS, draws: int = 30,
+def subsample_units(h: np.ndarray, fractions=SUBSAMPLE_FRACTIONS, draws: int = DEFAULTS.subsample_draws,
                     rng: np.random.Generator | int | None = None) -> pd.DataFrame:
     """D_eff of random subsets of units (SPEC 12: fractions .05 .15 .25 .5 .75 1, 30 draws each), Fig 6C.
 
@@ -92,7 +105,8 @@ def subsample_units(h: np.ndarray, fractions=SUBSAMPLE_FRACTIONS, draws: int = 3
     return pd.DataFrame(rows)
 
 
-def wideband_power(h: np.ndarray, window: int = 20, overlap: int = 10, fs: float = RATE_HZ) -> float:
+def wideband_power(h: np.ndarray, window: int = DEFAULTS.spectrogram_window,
+                   overlap: int = DEFAULTS.spectrogram_overlap, fs: float = RATE_HZ) -> float:
     """Mean spectrogram power over units, windows and frequencies (SPEC 12: 20-step windows, 10 overlap).
 
     scipy.signal.spectrogram with its defaults otherwise (Tukey window,
@@ -105,7 +119,9 @@ def wideband_power(h: np.ndarray, window: int = 20, overlap: int = 10, fs: float
     return float(sxx.mean())
 
 
-def dynamics_table(hidden: pd.DataFrame, fraction: float = 0.9, window: int = 20, overlap: int = 10) -> pd.DataFrame:
+def dynamics_table(hidden: pd.DataFrame, fraction: float = DEFAULTS.variance_fraction,
+                   window: int = DEFAULTS.spectrogram_window, overlap: int = DEFAULTS.spectrogram_overlap,
+                   fs: float = RATE_HZ) -> pd.DataFrame:
     """Per agent-episode of a hidden table: D_eff, PCs for ``fraction`` of the variance, wideband power, reason."""
     require(hidden, [*AGENT_EPISODE, "t"], "hidden table")
     rows = []
@@ -113,12 +129,13 @@ def dynamics_table(hidden: pd.DataFrame, fraction: float = 0.9, window: int = 20
         h = hidden_matrix(sub)
         rows.append({**dict(zip(AGENT_EPISODE, keys, strict=True)), "n_steps": len(h),
                      "d_eff": effective_dimensionality(h), "pcs_for_variance": pcs_for_variance(h, fraction),
-                     "wideband_power": wideband_power(h, window, overlap), "reason": degenerate_reason(h)})
+                     "wideband_power": wideband_power(h, window, overlap, fs), "reason": degenerate_reason(h)})
     return pd.DataFrame(rows, columns=[*AGENT_EPISODE, "n_steps", "d_eff", "pcs_for_variance", "wideband_power",
                                        "reason"])
 
 
-def decode(x: np.ndarray, y: np.ndarray, groups: np.ndarray, circular: bool = False, folds: int = 5) -> dict:
+def decode(x: np.ndarray, y: np.ndarray, groups: np.ndarray, circular: bool = False,
+           folds: int = DEFAULTS.decode_folds) -> dict:
     """Cross-validated linear readout of ``y`` from ``x`` (SPEC 12 "Decoding"), folds grouped by episode.
 
     OLS (sklearn LinearRegression) under GroupKFold(``folds``) over ``groups``
@@ -169,8 +186,8 @@ def _plsc_spectrum(za: np.ndarray, zb: np.ndarray, k: int) -> tuple[np.ndarray, 
     return s[:k], r
 
 
-def plsc(h_a: np.ndarray, h_b: np.ndarray, shifts: int = 30, rng: np.random.Generator | int | None = None,
-         percentile: float = 97.5) -> dict:
+def plsc(h_a: np.ndarray, h_b: np.ndarray, shifts: int = DEFAULTS.plsc_shifts,
+         rng: np.random.Generator | int | None = None, percentile: float = DEFAULTS.plsc_percentile) -> dict:
     """Partial least squares correlation of two agents' hidden states with a circular-shift null (SPEC 12).
 
     Both T x D matrices are z-scored per unit; the SVD of their
@@ -204,8 +221,9 @@ def plsc(h_a: np.ndarray, h_b: np.ndarray, shifts: int = 30, rng: np.random.Gene
             "n_significant": n_sig, "reason": ""}
 
 
-def plsc_by_distance(h_a: np.ndarray, h_b: np.ndarray, dist_cm: np.ndarray, edges_cm=(10.0, 100.0),
-                     shifts: int = 30, rng: np.random.Generator | int | None = None) -> pd.DataFrame:
+def plsc_by_distance(h_a: np.ndarray, h_b: np.ndarray, dist_cm: np.ndarray, edges_cm=tuple(DEFAULTS.plsc_edges_cm),
+                     shifts: int = DEFAULTS.plsc_shifts, rng: np.random.Generator | int | None = None,
+                     percentile: float = DEFAULTS.plsc_percentile) -> pd.DataFrame:
     """:func:`plsc` on the steps whose inter-agent distance falls in each bin (SPEC 12: <= 10, 10-100, > 100 cm).
 
     The steps of a bin are taken in time order and the null shifts them as one
@@ -221,7 +239,79 @@ def plsc_by_distance(h_a: np.ndarray, h_b: np.ndarray, dist_cm: np.ndarray, edge
     rows = []
     for lo, hi in itertools.pairwise(bounds):
         keep = (dist > lo) & (dist <= hi)
-        res = plsc(np.asarray(h_a)[keep], np.asarray(h_b)[keep], shifts, rng)
+        res = plsc(np.asarray(h_a)[keep], np.asarray(h_b)[keep], shifts, rng, percentile)
         rows.append({"lo_cm": max(lo, 0.0), "hi_cm": hi, "n_steps": int(keep.sum()),
                      "n_significant": res["n_significant"], "s_1": res["singular_values"][0], "reason": res["reason"]})
     return pd.DataFrame(rows)
+
+
+def subsample_table(hidden: pd.DataFrame, fractions=SUBSAMPLE_FRACTIONS, draws: int = DEFAULTS.subsample_draws,
+                    rng: np.random.Generator | int | None = None) -> pd.DataFrame:
+    """:func:`subsample_units` of every agent-episode of a hidden table (Fig 6C), keyed by condition, episode, agent."""
+    require(hidden, [*AGENT_EPISODE, "t"], "hidden table")
+    rng = np.random.default_rng(rng)
+    parts = [subsample_units(hidden_matrix(sub), fractions, draws, rng).assign(**dict(zip(AGENT_EPISODE, keys,
+                                                                                           strict=True)))
+             for keys, sub in hidden.groupby(AGENT_EPISODE, sort=True)]
+    if not parts:
+        return nan_frame("empty hidden table", fraction=np.nan, n_units=0, draw=np.nan, d_eff=np.nan)
+    return pd.concat(parts, ignore_index=True)
+
+
+def _with_steps(hidden: pd.DataFrame, steps: pd.DataFrame, columns: list[str]) -> pd.DataFrame:
+    """Hidden rows joined with ``columns`` of the steps table on (condition, episode, agent, t), in that order."""
+    keys = [*AGENT_EPISODE, "t"]
+    require(hidden, keys, "hidden table")
+    require(steps, [*keys, *columns], "steps table")
+    return hidden.merge(steps[[*keys, *columns]], on=keys).sort_values(keys, kind="stable")
+
+
+def decode_table(hidden: pd.DataFrame, steps: pd.DataFrame, targets: dict[str, bool] | None = None,
+                 folds: int = DEFAULTS.decode_folds) -> pd.DataFrame:
+    """:func:`decode` of every target column of ``steps`` from the hidden state, per condition (Fig 6D-F).
+
+    All agents of a condition are pooled and folds are grouped by episode.
+    ``targets`` maps a steps column to whether it is circular (default
+    :data:`DECODE_TARGETS`). One row per condition and target (columns
+    :data:`DECODE_COLUMNS`); a target the steps table lacks is NaN with a reason.
+    """
+    targets = DECODE_TARGETS if targets is None else targets
+    present = [c for c in targets if c in steps.columns]
+    joined = _with_steps(hidden, steps, present)
+    h, rows = units(hidden), []
+    for cond, sub in joined.groupby("condition", sort=True):
+        x = sub[h].to_numpy(np.float64)
+        for target, circular in targets.items():
+            res = (decode(x, sub[target].to_numpy(np.float64), sub["episode"].to_numpy(), circular, folds)
+                   if target in present else {"reason": f"steps table lacks column {target!r}"})
+            rows.append({"condition": cond, "target": target, "circular": circular, **res})
+    if not rows:
+        return nan_frame("no hidden row matches a step").reindex(columns=DECODE_COLUMNS)
+    return pd.DataFrame(rows, columns=DECODE_COLUMNS)
+
+
+def plsc_table(hidden: pd.DataFrame, steps: pd.DataFrame, agents: tuple[int, int] = (0, 1),
+               edges_cm=tuple(DEFAULTS.plsc_edges_cm), shifts: int = DEFAULTS.plsc_shifts,
+               rng: np.random.Generator | int | None = None,
+               percentile: float = DEFAULTS.plsc_percentile) -> pd.DataFrame:
+    """:func:`plsc_by_distance` of two agents' hidden states per condition (Fig 6G,H).
+
+    Uses the steps at which both ``agents`` have a hidden state, episode after
+    episode in time order; their distance comes from the steps table's
+    positions. One row per condition and distance bin, with ``agent_a`` and
+    ``agent_b``; without a shared step, one NaN row with a reason.
+    """
+    keys = [*EPISODE, "t"]
+    pos = _with_steps(hidden, steps, ["x_cm", "y_cm"])
+    a, b = (pos[pos["agent"] == i].set_index(keys).sort_index() for i in agents)
+    shared = a.index.intersection(b.index)
+    if shared.empty:
+        return nan_frame(f"agents {agents[0]} and {agents[1]} share no step", condition=np.nan, n_steps=0)
+    a, b, h = a.loc[shared], b.loc[shared], units(hidden)
+    dist = np.hypot(a["x_cm"].to_numpy(np.float64) - b["x_cm"].to_numpy(np.float64),
+                    a["y_cm"].to_numpy(np.float64) - b["y_cm"].to_numpy(np.float64))
+    rng, condition = np.random.default_rng(rng), shared.get_level_values("condition")
+    parts = [plsc_by_distance(a[h].to_numpy()[condition == c], b[h].to_numpy()[condition == c],
+                              dist[condition == c], edges_cm, shifts, rng, percentile).assign(condition=c)
+             for c in sorted(set(condition))]
+    return pd.concat(parts, ignore_index=True).assign(agent_a=agents[0], agent_b=agents[1])

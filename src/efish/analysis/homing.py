@@ -109,18 +109,20 @@ def trajectory_shape(steps: pd.DataFrame) -> pd.DataFrame:
     return out.drop(columns=["x0", "y0", "x1", "y1", "n_missing"])
 
 
-def compare_perception(steps: pd.DataFrame, electric: str = "electric", raycasting: str = "raycasting",
+def compare_perception(steps: pd.DataFrame, electric: str = "electric", raycasting: str | None = "raycasting",
                        agent: int | None = None) -> pd.DataFrame:
     """Mann-Whitney tests of trajectory shape, ray-casting vs electric (Fig 2B), one row per measure.
 
-    ``electric`` and ``raycasting`` are the two condition names; ``agent``
-    keeps only the homer. Rows are :mod:`efish.analysis.stats` rows plus ``measure``.
+    ``electric`` and ``raycasting`` are the two condition names; ``raycasting=None``
+    compares every other condition with ``electric`` (none: NaN rows that say
+    so). ``agent`` keeps only the homer. Rows are :mod:`efish.analysis.stats` rows plus ``measure``.
     """
     shape = trajectory_shape(steps)
     if agent is not None:
         shape = shape[shape["agent"] == agent]
-    shape = shape[shape["condition"].isin([electric, raycasting])]
-    if raycasting not in set(shape["condition"]):
-        raise ValueError(f"condition {raycasting!r} is not in the steps table")
+    if raycasting is not None:
+        shape = shape[shape["condition"].isin([electric, raycasting])]
+        if raycasting not in set(shape["condition"]):
+            raise ValueError(f"condition {raycasting!r} is not in the steps table")
     return pd.concat([mann_whitney(shape, m, "condition", electric).assign(measure=m) for m in SHAPE_MEASURES],
                      ignore_index=True)

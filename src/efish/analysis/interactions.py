@@ -22,7 +22,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ._tables import AGENT_EPISODE, EPISODE, agent_sizes, nan_frame, pairs, require, run_ids, wrap
+from ._tables import AGENT_EPISODE, DEFAULTS, EPISODE, agent_sizes, nan_frame, pairs, require, run_ids, wrap
+from .stats import wilcoxon_paired
 
 LABELS = ("confronting", "chasing", "fleeing", "dispersing", "unaligned", "undefined")
 #: Bout classes, in the order that breaks ties of the mode.
@@ -44,7 +45,7 @@ def _labels(p: pd.DataFrame, facing_rad: float, away_rad: float) -> np.ndarray:
     return np.where(defined, label, "undefined")
 
 
-def label_steps(steps: pd.DataFrame, facing_rad: float = np.pi / 4, away_rad: float = 3 * np.pi / 4,
+def label_steps(steps: pd.DataFrame, facing_rad: float = DEFAULTS.facing_rad, away_rad: float = DEFAULTS.away_rad,
                 within_cm: float | None = None) -> pd.DataFrame:
     """Label every ordered pair of agents at every step (module docstring; SPEC 12 thresholds pi/4, 3 pi/4).
 
@@ -64,8 +65,8 @@ def label_steps(steps: pd.DataFrame, facing_rad: float = np.pi / 4, away_rad: fl
     return p[[*EPISODE, "t", "agent", "partner", "dist_cm"]].assign(label=_labels(p, facing_rad, away_rad))
 
 
-def bouts(steps: pd.DataFrame, within_cm: float = 10.0, contact_cm: float = 2.0, facing_rad: float = np.pi / 4,
-          away_rad: float = 3 * np.pi / 4) -> pd.DataFrame:
+def bouts(steps: pd.DataFrame, within_cm: float = DEFAULTS.bout_cm, contact_cm: float = DEFAULTS.contact_cm,
+          facing_rad: float = DEFAULTS.facing_rad, away_rad: float = DEFAULTS.away_rad) -> pd.DataFrame:
     """Bouts of every unordered pair (``agent`` < ``partner``): maximal runs of consecutive steps within ``within_cm``.
 
     Per bout: ``t_start`` and ``t_end`` (inclusive), ``n_steps``, ``min_dist_cm``,
@@ -115,9 +116,13 @@ def _with_sizes(table: pd.DataFrame, steps: pd.DataFrame, who: list[str]) -> pd.
         [table["condition"], table["episode"], table[c]])).to_numpy() for c in who})
 
 
-def chase_sizes(steps: pd.DataFrame, within_cm: float = 10.0) -> pd.DataFrame:
-    """Chaser and chased of every chasing bout with their sizes and the size difference (Fig 5K,L)."""
-    b = bouts(steps, within_cm)
+def chase_sizes(steps: pd.DataFrame, within_cm: float = DEFAULTS.bout_cm,
+                bout_table: pd.DataFrame | None = None) -> pd.DataFrame:
+    """Chaser and chased of every chasing bout with their sizes and the size difference (Fig 5K,L).
+
+    ``bout_table``: the :func:`bouts` of ``steps`` when already computed (then ``within_cm`` is unused).
+    """
+    b = bouts(steps, within_cm) if bout_table is None else bout_table
     b = b[b["chaser"] >= 0][[*EPISODE, "bout", "t_start", "n_steps", "chaser", "chased"]].reset_index(drop=True)
     b = _with_sizes(b, steps, ["chaser", "chased"])
     return b.assign(size_difference=b["chaser_size"] - b["chased_size"])
@@ -132,14 +137,16 @@ def bite_sizes(steps: pd.DataFrame) -> pd.DataFrame:
     return bites.assign(size_difference=bites["biter_size"] - bites["bitten_size"])
 
 
-def bite_timing(steps: pd.DataFrame, within_cm: float = 10.0) -> pd.DataFrame:
+def bite_timing(steps: pd.DataFrame, within_cm: float = DEFAULTS.bout_cm,
+                bout_table: pd.DataFrame | None = None) -> pd.DataFrame:
     """When bites fall within their bouts (Fig 5O): one row per bite inside a bout.
 
     ``t_from_start`` counts steps from the bout's first step; ``phase`` =
     (t - t_start + 0.5) / n_steps lies in (0, 1) for any bout length, so a
     one-step bout puts its bite at 0.5 rather than dividing by zero.
+    ``bout_table``: the :func:`bouts` of ``steps`` when already computed.
     """
-    b = bouts(steps, within_cm)
+    b = bouts(steps, within_cm) if bout_table is None else bout_table
     bites = bite_sizes(steps)[[*EPISODE, "t", "biter", "bitten"]]
     bites = bites.assign(agent=np.minimum(bites["biter"], bites["bitten"]),
                          partner=np.maximum(bites["biter"], bites["bitten"]))
@@ -151,8 +158,8 @@ def bite_timing(steps: pd.DataFrame, within_cm: float = 10.0) -> pd.DataFrame:
         drop=True)
 
 
-def bite_rate_by_class(steps: pd.DataFrame, within_cm: float = 10.0, facing_rad: float = np.pi / 4,
-                       away_rad: float = 3 * np.pi / 4) -> pd.DataFrame:
+def bite_rate_by_class(steps: pd.DataFrame, within_cm: float = DEFAULTS.bout_cm,
+                       facing_rad: float = DEFAULTS.facing_rad, away_rad: float = DEFAULTS.away_rad) -> pd.DataFrame:
     """Bites per pair-step by the biter's per-step label, over pairs within ``within_cm`` (Fig 5P).
 
     For each ordered pair-step (agent, partner) within range the agent either
@@ -172,3 +179,36 @@ def bite_rate_by_class(steps: pd.DataFrame, within_cm: float = 10.0, facing_rad:
     out["rate"] = np.divide(out["bites"], out["n_steps"], out=np.full(len(out), np.nan), where=out["n_steps"] > 0)
     out["reason"] = np.where(out["n_steps"] > 0, "", "label never seen within range")
     return out
+
+
+def label_counts(steps: pd.DataFrame, facing_rad: float = DEFAULTS.facing_rad,
+                 away_rad: float = DEFAULTS.away_rad) -> pd.DataFrame:
+    """The ethogram (Fig 3A): ordered pair-steps per condition and :func:`label_steps` label, and their fraction.
+
+    Every label of :data:`LABELS` is listed per condition, zeros included; an
+    empty table (or a lone agent) gives one NaN row with a reason.
+    """
+    labels = label_steps(steps, facing_rad, away_rad)
+    if labels.empty:
+        return nan_frame("no pair of agents", condition=np.nan, label=np.nan, n_steps=0, fraction=np.nan)
+    grid = pd.MultiIndex.from_product([sorted(labels["condition"].unique()), LABELS], names=["condition", "label"])
+    out = labels.groupby(["condition", "label"]).size().reindex(grid, fill_value=0).rename("n_steps").reset_index()
+    out["fraction"] = out["n_steps"] / out.groupby("condition")["n_steps"].transform("sum")
+    return out.assign(reason="")
+
+
+def size_role_tests(chases: pd.DataFrame, bites: pd.DataFrame) -> pd.DataFrame:
+    """Is the chaser larger than the chased, the biter than the bitten? Wilcoxon signed-rank per condition.
+
+    ``chases`` and ``bites`` are :func:`chase_sizes` and :func:`bite_sizes`
+    tables; each chasing bout or bite is one pair. Rows of
+    :mod:`efish.analysis.stats` (group ``chaser`` vs control ``chased``, effect
+    the median size difference) with ``measure`` (``chase`` or ``bite``) and ``condition``.
+    """
+    parts = []
+    for measure, table, role, other in (("chase", chases, "chaser", "chased"), ("bite", bites, "biter", "bitten")):
+        for cond, sub in list(table.groupby("condition", sort=True)) or [(np.nan, table)]:
+            long = pd.concat([pd.DataFrame({"pair": np.arange(len(sub)), "role": r,
+                                            "size": sub[f"{r}_size"].to_numpy(np.float64)}) for r in (role, other)])
+            parts.append(wilcoxon_paired(long, "size", "role", other, "pair").assign(measure=measure, condition=cond))
+    return pd.concat(parts, ignore_index=True)

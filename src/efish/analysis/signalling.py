@@ -13,10 +13,21 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ._tables import AGENT_EPISODE, EPISODE, RATE_HZ, STEP_MS, agent_sizes, eod_rate, nan_frame, pairs, require
+from ._tables import (
+    AGENT_EPISODE,
+    DEFAULTS,
+    EPISODE,
+    RATE_HZ,
+    STEP_MS,
+    agent_sizes,
+    eod_rate,
+    nan_frame,
+    pairs,
+    require,
+)
 
 #: Distance column and default binning range (cm) per ``to`` of :func:`eod_rate_by_distance` (SPEC 12).
-DISTANCE_RANGES_CM = {"agent": (0.0, 150.0), "food": (0.0, 10.0), "wall": (0.0, 10.0)}
+DISTANCE_RANGES_CM = {to: (0.0, getattr(DEFAULTS, f"{to}_range_cm")) for to in ("agent", "food", "wall")}
 #: Event columns :func:`peri_event_rate` aligns on: eating, biting, being bitten.
 EVENTS = ("ate", "bit", "was_bitten")
 
@@ -35,7 +46,8 @@ def idis(steps: pd.DataFrame, step_ms: float = STEP_MS) -> pd.DataFrame:
     return out.reset_index(drop=True)
 
 
-def idi_histogram(idi_ms, bins: int = 50, lo_ms: float = 10.0, hi_ms: float = 3000.0) -> pd.DataFrame:
+def idi_histogram(idi_ms, bins: int = DEFAULTS.idi_bins, lo_ms: float = DEFAULTS.idi_lo_ms,
+                  hi_ms: float = DEFAULTS.idi_hi_ms) -> pd.DataFrame:
     """Counts and density of IDIs on ``bins`` log-spaced bins over [``lo_ms``, ``hi_ms``] (SPEC 12).
 
     The density is per ms, so histograms with different bin widths compare.
@@ -48,7 +60,7 @@ def idi_histogram(idi_ms, bins: int = 50, lo_ms: float = 10.0, hi_ms: float = 30
     return pd.DataFrame({"bin_lo_ms": edges[:-1], "bin_hi_ms": edges[1:], "count": counts, "density": density})
 
 
-def fit_power_law(idi_ms, xmin_ms: float = 12.0, min_n: int = 10) -> dict:
+def fit_power_law(idi_ms, xmin_ms: float = DEFAULTS.xmin_ms, min_n: int = 10) -> dict:
     """Power-law fit of IDIs >= ``xmin_ms`` with ``powerlaw.Fit``, compared with lognormal and exponential.
 
     Returns ``alpha``, ``xmin``, ``n`` (IDIs in the fit), and for each
@@ -118,8 +130,9 @@ def _binned_mean_sem(values: np.ndarray, x: np.ndarray, edges: np.ndarray, min_s
                          "mean_hz": table["mean"].to_numpy(), "sem_hz": table["sem"].to_numpy(), "reason": ""})
 
 
-def eod_rate_by_distance(steps: pd.DataFrame, to: str, bins: int = 15, range_cm: tuple[float, float] | None = None,
-                         min_samples: int = 5, window: int = 20, rate_hz: float = RATE_HZ) -> pd.DataFrame:
+def eod_rate_by_distance(steps: pd.DataFrame, to: str, bins: int = DEFAULTS.rate_bins,
+                         range_cm: tuple[float, float] | None = None, min_samples: int = DEFAULTS.min_samples,
+                         window: int = DEFAULTS.rate_window, rate_hz: float = RATE_HZ) -> pd.DataFrame:
     """Mean +- SEM EOD rate (Hz) in ``bins`` equal distance bins to the nearest ``to`` (agent, food or wall).
 
     Ranges default to SPEC 12: 0-150 cm for agents, 0-10 cm for food and wall.
@@ -152,8 +165,9 @@ def _event_triggered(rate: np.ndarray, events: np.ndarray, lags: np.ndarray) -> 
     return pd.DataFrame(vals).mean().to_numpy()  # pandas: a lag no event reaches is NaN, without a warning
 
 
-def peri_event_rate(steps: pd.DataFrame, event: str, window: int = 100, min_events: int = 3,
-                    rate_window: int = 20, rate_hz: float = RATE_HZ) -> pd.DataFrame:
+def peri_event_rate(steps: pd.DataFrame, event: str, window: int = DEFAULTS.peri_window,
+                    min_events: int = DEFAULTS.min_events, rate_window: int = DEFAULTS.rate_window,
+                    rate_hz: float = RATE_HZ) -> pd.DataFrame:
     """Mean +- SEM EOD rate (Hz) from ``window`` steps before to ``window`` after an ``event`` (SPEC 12).
 
     ``event`` is a boolean steps column: ``ate``, ``bit`` or ``was_bitten``.
@@ -183,12 +197,12 @@ def peri_event_rate(steps: pd.DataFrame, event: str, window: int = 100, min_even
         return nan_frame("empty steps table", condition=np.nan, lag=np.nan, n_agents=0, mean_hz=np.nan,
                          sem_hz=np.nan)
     out = pd.concat(parts, ignore_index=True).assign(event=event)
-    out["lag_ms"] = out["lag"] * STEP_MS
+    out["lag_ms"] = out["lag"] * 1000.0 / rate_hz  # rate_hz is the step rate (env.fps)
     return out
 
 
-def rate_advantage_vs_size(steps: pd.DataFrame, within_cm: float = 10.0, window: int = 20,
-                           rate_hz: float = RATE_HZ) -> pd.DataFrame:
+def rate_advantage_vs_size(steps: pd.DataFrame, within_cm: float = DEFAULTS.bout_cm,
+                           window: int = DEFAULTS.rate_window, rate_hz: float = RATE_HZ) -> pd.DataFrame:
     """Per pair of agents and episode: EOD-rate advantage vs size advantage while within ``within_cm`` (Fig 3P).
 
     One row per unordered pair (``agent`` < ``partner``): ``size_advantage`` =

@@ -97,6 +97,12 @@ def dunnett_vs_control(df: pd.DataFrame, value: str, group: str, control, rng: i
                         columns=STAT_COLUMNS)
 
 
+def dunnett_by_measure(df: pd.DataFrame, values: list[str], group: str, control, rng: int = 0) -> pd.DataFrame:
+    """:func:`dunnett_vs_control` of each column in ``values``, stacked, with a ``measure`` column naming it."""
+    return pd.concat([dunnett_vs_control(df, v, group, control, rng).assign(measure=v) for v in values],
+                     ignore_index=True)
+
+
 def mann_whitney(df: pd.DataFrame, value: str, group: str, control) -> pd.DataFrame:
     """Two-sided Mann-Whitney U test of every group against ``control`` (scipy.stats.mannwhitneyu).
 

@@ -9,6 +9,7 @@ whole tree and name the offending key.
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -202,6 +203,16 @@ class EnvConfig:
     homing_reward_home: float = param(10.0, "homing: reward per step at home")
     homing_shaping: float = param(0.01, "homing: times (d_prev - d) / perimeter")
     homing_step_cost: float = param(0.05, "homing: cost per step")
+    homing_min_distance_cm: float = param(0.0, "homing starts: every homer at least this far from the target, cm "
+                                          "(the assay: 20)", lo=0.0)
+    homing_clearance_cm: float = param(0.0, "homing starts: target and homers at least this far from every wall, "
+                                       "cm (the assay: 5)", lo=0.0)
+    roles: list = param([], "start placement per agent: random, resident (arena centre), intruder (facing the "
+                        "resident from intruder_distance_cm), approach (facing the centre from one of "
+                        "approach_distances_cm); empty = all random")
+    intruder_distance_cm: list = param([20.0, 100.0], "intruder: [min, max] start distance from the resident, cm")
+    approach_distances_cm: list = param([25.0, 50.0], "approach: start distances from the arena centre, one drawn "
+                                        "per episode, cm")
 
 
 # ----------------------------------------------------------------------- train
@@ -287,6 +298,46 @@ class ScaleConfig:
     assays: list = param(["patchy4", "homing"], "assays the pipeline runs (names of config/assay/*.yaml)")
 
 
+# -------------------------------------------------------------------- analysis
+@dataclass
+class AnalysisConfig:
+    """Parameters of the analyses of SPEC 12 (``efish analyze``); ms per step and rates in Hz follow ``env.fps``."""
+
+    idi_bins: int = param(50, "IDI histogram: log-spaced bins", lo=1, hi=100_000)
+    idi_lo_ms: float = param(10.0, "IDI histogram: lower edge, ms (> 0, below idi_hi_ms)", lo=0.0)
+    idi_hi_ms: float = param(3000.0, "IDI histogram: upper edge, ms", lo=0.0)
+    xmin_ms: float = param(12.0, "power-law fit: smallest IDI fitted, ms", lo=0.0)
+    rate_window: int = param(20, "EOD rate: centred rolling mean of eod over this many steps", lo=1)
+    rate_bins: int = param(15, "EOD rate vs distance: equal distance bins", lo=1, hi=100_000)
+    agent_range_cm: float = param(150.0, "EOD rate vs nearest-agent distance: bins span 0 to this, cm", lo=0.0)
+    food_range_cm: float = param(10.0, "EOD rate vs nearest-food distance: bins span 0 to this, cm", lo=0.0)
+    wall_range_cm: float = param(10.0, "EOD rate vs wall distance: bins span 0 to this, cm", lo=0.0)
+    min_samples: int = param(5, "EOD rate vs distance: bins with fewer steps are dropped", lo=1)
+    peri_window: int = param(100, "peri-event EOD rate: steps before and after each event", lo=1)
+    min_events: int = param(3, "peri-event EOD rate: agent-episodes with fewer events are left out", lo=1)
+    facing_rad: float = param(math.pi / 4, "interaction labels: |heading - bearing to the partner| at most this "
+                              "faces it, rad", lo=0.0, hi=math.pi)
+    away_rad: float = param(3 * math.pi / 4, "interaction labels: at least this faces away, rad", lo=0.0, hi=math.pi)
+    bout_cm: float = param(10.0, "a pair this close interacts: bouts, bite rate by class, EOD-rate advantage, cm",
+                           lo=0.0)
+    contact_cm: float = param(2.0, "a bout whose centres come this close is a contact, cm", lo=0.0)
+    variance_fraction: float = param(0.9, "hidden states: PCs counted until they explain this fraction of the "
+                                     "variance", lo=0.0, hi=1.0)
+    subsample_fractions: list = param([0.05, 0.15, 0.25, 0.5, 0.75, 1.0], "unit subsampling: fractions of the "
+                                      "hidden units kept, each in (0, 1]")
+    subsample_draws: int = param(30, "unit subsampling: random draws per fraction", lo=1)
+    decode_folds: int = param(5, "decoding: GroupKFold folds over episodes", lo=2)
+    plsc_shifts: int = param(30, "PLSC: circular shifts of the null", lo=1)
+    plsc_percentile: float = param(97.5, "PLSC: a component beats this percentile of the null to count", lo=0.0,
+                                   hi=100.0)
+    plsc_edges_cm: list = param([10.0, 100.0], "PLSC: distance bin edges, increasing (<= first, ..., > last), cm")
+    spectrogram_window: int = param(20, "wideband power: spectrogram window, steps", lo=1)
+    spectrogram_overlap: int = param(10, "wideband power: overlap of consecutive windows, steps (< window)", lo=0)
+    seed: int = param(0, "seed of unit subsampling, PLSC null shifts and Dunnett's p-values", lo=0)
+    real_fish_idis: str = param("", "CSV or Parquet of real-fish IDIs (column idi_ms); empty: none, and the IDI "
+                                "tables say so in their reason column")
+
+
 @dataclass
 class EfishConfig:
     """The whole composed config."""
@@ -299,10 +350,11 @@ class EfishConfig:
     assay: AssayConfig = group(AssayConfig)
     bench: BenchConfig = group(BenchConfig)
     scale: ScaleConfig = group(ScaleConfig)
+    analysis: AnalysisConfig = group(AnalysisConfig)
 
 
-# Groups whose values a training run depends on; the rest (assay, bench, scale) only name or size other jobs,
-# and what the scale sets for training reaches it through train.* (resolved).
+# Groups whose values a training run depends on; the rest (assay, bench, scale, analysis) only name or size other
+# jobs, and what the scale sets for training reaches it through train.* (resolved).
 TRAINING_GROUPS = ("physics", "sensors", "arena", "env", "train")
 
 
@@ -382,6 +434,13 @@ def _check_consistency(obj: Any, path: str) -> None:
             raise ConfigError(f"{path}homing_target={obj.homing_target} is not an agent id (0..{obj.n_agents - 1})")
         if obj.starts and (len(obj.starts) != obj.n_agents or any(len(x) != 3 for x in obj.starts)):
             raise ConfigError(f"{path}starts must hold {obj.n_agents} entries [x_cm, y_cm, heading_rad]")
+        roles = ("random", "resident", "intruder", "approach")
+        if obj.roles and (len(obj.roles) != obj.n_agents or any(r not in roles for r in obj.roles)):
+            raise ConfigError(f"{path}roles must hold {obj.n_agents} of {', '.join(roles)}, got {obj.roles}")
+        if len(obj.intruder_distance_cm) != 2 or not 0 <= obj.intruder_distance_cm[0] <= obj.intruder_distance_cm[1]:
+            raise ConfigError(f"{path}intruder_distance_cm must be [min, max] with 0 <= min <= max")
+        if not obj.approach_distances_cm or min(obj.approach_distances_cm) < 0:
+            raise ConfigError(f"{path}approach_distances_cm must hold at least one distance >= 0")
     if isinstance(obj, ArenaConfig):
         if obj.train_multiplier_min > obj.train_multiplier_max or obj.train_multiplier_min <= 0:
             raise ConfigError(f"{path}train_multiplier_min must be > 0 and <= {path}train_multiplier_max")
@@ -391,6 +450,8 @@ def _check_consistency(obj: Any, path: str) -> None:
         levels = list(obj.far_field_levels)
         if any(q % 2 == 0 or not 3 <= q <= 63 for q in levels) or levels != sorted(set(levels)):
             raise ConfigError(f"{path}far_field_levels={levels} must hold increasing odd counts in [3, 63]")
+    if isinstance(obj, AnalysisConfig):
+        _check_analysis(obj, path)
     if isinstance(obj, (MormyromastConfig, AmpullaryConfig)) and not 0 < obj.e_min < obj.e_max:
         raise ConfigError(f"{path}e_min={obj.e_min:g} must be > 0 and below {path}e_max={obj.e_max:g}")
     if isinstance(obj, MormyromastConfig) and obj.chin_count > obj.count:
@@ -401,3 +462,20 @@ def _check_consistency(obj: Any, path: str) -> None:
         if obj.interference_low > obj.interference_high:
             raise ConfigError(f"{path}interference_low exceeds {path}interference_high")
 
+
+
+def _check_analysis(obj: AnalysisConfig, path: str) -> None:
+    """Cross-field rules of the analysis group."""
+    if not 0 < obj.idi_lo_ms < obj.idi_hi_ms:
+        raise ConfigError(f"{path}idi_lo_ms={obj.idi_lo_ms:g} must be > 0 and below "
+                          f"{path}idi_hi_ms={obj.idi_hi_ms:g}")
+    if obj.facing_rad > obj.away_rad:
+        raise ConfigError(f"{path}facing_rad={obj.facing_rad:g} exceeds {path}away_rad={obj.away_rad:g}")
+    if obj.spectrogram_overlap >= obj.spectrogram_window:
+        raise ConfigError(f"{path}spectrogram_overlap={obj.spectrogram_overlap} must be below "
+                          f"{path}spectrogram_window={obj.spectrogram_window}")
+    if not obj.subsample_fractions or any(not 0 < f <= 1 for f in obj.subsample_fractions):
+        raise ConfigError(f"{path}subsample_fractions={list(obj.subsample_fractions)} must hold values in (0, 1]")
+    edges = list(obj.plsc_edges_cm)
+    if edges != sorted(set(edges)) or any(e < 0 for e in edges):
+        raise ConfigError(f"{path}plsc_edges_cm={edges} must be increasing distances >= 0")

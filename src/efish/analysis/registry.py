@@ -1,0 +1,273 @@
+"""Every analysis ``efish analyze`` runs: the rollout tables it reads, the assays it belongs to, the tables it writes.
+
+The workflow reads :data:`ANALYSES` to make one job per (analysis, assay of
+the scale), writing ``results/{run}/analysis/<analysis>/<assay>/<table>.parquet``;
+adding an analysis means one compute function and one entry here. Each
+compute function passes the composed config's values (``cfg.analysis``,
+``env.fps`` for ms per step and rates in Hz, the arena for the one-patch
+centre) to the pure functions of the ``efish.analysis`` modules; a statistic
+table (:attr:`Analysis.stats`) carries the columns of
+:data:`efish.analysis.stats.STAT_COLUMNS`. A table whose input columns the
+rollout does not record yet (``bite_target``, the ``err_*_rad`` angles) is one
+NaN row whose ``reason`` names them, so every declared table is always written.
+
+>>> [a.name for a in analyses_for("homing", tables_written(AssayConfig(name="homing")))]
+['homing']
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..config.schema import AssayConfig, EfishConfig
+from ..io import read_parquet
+from ._tables import nan_frame, or_nan_row, require
+from .behaviour import (
+    bite_matrix,
+    eod_probability,
+    episode_summary,
+    food_per_agent_episode,
+    food_time_course,
+    food_vs_size,
+    nearest_neighbour,
+    reach_rates,
+    theil_per_episode,
+    win_ratios,
+)
+from .dynamics import decode_table, dynamics_table, plsc_table, subsample_table
+from .homing import ERROR_COLUMNS, compare_perception, error_histogram, error_vs_time, trajectory_shape
+from .interactions import bite_rate_by_class, bite_sizes, bite_timing, bouts, chase_sizes, label_counts, size_role_tests
+from .signalling import (
+    EVENTS,
+    eod_rate_by_distance,
+    fit_power_law,
+    idi_histogram,
+    idis,
+    load_real_idis,
+    peri_event_rate,
+    rate_advantage_vs_size,
+)
+from .stats import STAT_COLUMNS, dunnett_by_measure, spearman
+
+Tables = dict[str, pd.DataFrame]
+#: Tables every assay writes; ``hidden`` only with ``assay.record_hidden`` (a key the assays issue adds).
+ROLLOUT_TABLES = ("steps", "episodes", "food")
+#: Per-episode measures of :func:`efish.analysis.behaviour.episode_summary` compared between conditions.
+SUMMARY_MEASURES = ["food_total", "theil_t", "eod_probability", "mean_nn_dist_cm", "bites"]
+#: Per-agent-episode measures of :func:`efish.analysis.dynamics.dynamics_table` compared between conditions.
+DYNAMICS_MEASURES = ["d_eff", "pcs_for_variance", "wideband_power"]
+
+
+@dataclass(frozen=True)
+class Analysis:
+    """One analysis: its compute function, the rollout tables it reads, its SPEC 11 assays and output tables."""
+
+    name: str
+    compute: Callable[[Tables, EfishConfig], Tables]
+    reads: tuple[str, ...]
+    assays: tuple[str, ...]
+    outputs: tuple[str, ...]
+    stats: tuple[str, ...] = ()  # outputs that are statistic tables (STAT_COLUMNS)
+
+
+# ------------------------------------------------------------------ helpers
+def control_condition(conditions: Iterable, cfg: EfishConfig):
+    """The condition others are compared with: the assay's first listed condition if present, else the first present."""
+    present = sorted(c for c in set(conditions) if isinstance(c, str))
+    first = next(iter(cfg.assay.conditions), None)
+    return first if first in present or not present else present[0]
+
+
+def _lacking(table: pd.DataFrame, columns: Iterable[str], outputs: Iterable[str], stats: Iterable[str] = ()) -> Tables:
+    """One NaN row per output, whose reason names the ``columns`` the table lacks (empty dict: none lacking)."""
+    missing = sorted(set(columns) - set(table.columns))
+    if not missing:
+        return {}
+    row = nan_frame(f"the rollout table lacks columns {missing}")
+    return {name: row.reindex(columns=STAT_COLUMNS) if name in stats else row for name in outputs}
+
+
+def _homer(cfg: EfishConfig) -> int | None:
+    """The homing agent (the one that is not the target) of a two-agent homing config; None otherwise."""
+    if cfg.env.task != "homing" or cfg.env.n_agents != 2:
+        return None
+    return 1 - cfg.env.homing_target
+
+
+# ------------------------------------------------------------- signalling
+def _idi_samples(ids: pd.DataFrame, conditions: Iterable, cfg: EfishConfig) -> dict[tuple, np.ndarray | str]:
+    """IDIs (ms) per (source, condition): the agents' per condition and the real fish's, or why there are none."""
+    samples = {("agents", c): ids.loc[ids["condition"] == c, "idi_ms"].to_numpy() for c in sorted(conditions)}
+    real = load_real_idis(cfg.analysis.real_fish_idis)
+    samples["real_fish", np.nan] = real["reason"].iloc[0] or real["idi_ms"].to_numpy()
+    return samples
+
+
+def _idi_tables(ids: pd.DataFrame, conditions: Iterable, cfg: EfishConfig) -> Tables:
+    """IDI histograms and power-law fits per source and condition (Fig 3C,D; supplement)."""
+    a, hist, fits = cfg.analysis, [], []
+    for (source, cond), x in _idi_samples(ids, conditions, cfg).items():
+        keys = {"source": source, "condition": cond}
+        if isinstance(x, str):  # no sample: say why
+            hist.append(nan_frame(x, **keys))
+            fits.append({**keys, **fit_power_law([], a.xmin_ms), "reason": x})
+            continue
+        h = idi_histogram(x, a.idi_bins, a.idi_lo_ms, a.idi_hi_ms)
+        hist.append(h.assign(**keys, reason="" if h["count"].sum() else "no IDI in the histogram range"))
+        fits.append({**keys, **fit_power_law(x, a.xmin_ms)})
+    return {"idi_histogram": pd.concat(hist, ignore_index=True), "power_law": pd.DataFrame(fits)}
+
+
+def _signalling(t: Tables, cfg: EfishConfig) -> Tables:
+    """IDIs, their histograms and power laws, EOD rate vs distance and around events, rate vs size (Fig 3C-J,P)."""
+    a, steps, fps = cfg.analysis, t["steps"], cfg.env.fps
+    ranges = {"agent": a.agent_range_cm, "food": a.food_range_cm, "wall": a.wall_range_cm}
+    ids, advantage = idis(steps, 1000.0 / fps), rate_advantage_vs_size(steps, a.bout_cm, a.rate_window, fps)
+    return {
+        "idis": or_nan_row(ids, "no agent discharged twice"), **_idi_tables(ids, steps["condition"].unique(), cfg),
+        "rate_by_distance": pd.concat([eod_rate_by_distance(steps, to, a.rate_bins, (0.0, hi), a.min_samples,
+                                                            a.rate_window, fps) for to, hi in ranges.items()],
+                                      ignore_index=True),
+        "peri_event": pd.concat([peri_event_rate(steps, e, a.peri_window, a.min_events, a.rate_window, fps)
+                                 for e in EVENTS], ignore_index=True),
+        "rate_advantage": advantage,
+        "rate_tests": spearman(advantage, "size_advantage", "rate_advantage_hz", by="condition"),
+    }
+
+
+# -------------------------------------------------------------- behaviour
+def _behaviour(t: Tables, cfg: EfishConfig) -> Tables:
+    """Food, food vs size, Theil T, win ratios, bites by size, spacing, EOD probability, condition tests (Figs 3-4)."""
+    episodes, steps = t["episodes"], t["steps"]
+    wins, eod, summary = win_ratios(episodes), eod_probability(steps), episode_summary(episodes)
+    control = control_condition(summary["condition"], cfg)
+    bites = _lacking(steps, ["bite_target"], ["bite_matrix"]) or {"bite_matrix": bite_matrix(steps)}
+    return {
+        "food_per_agent": food_per_agent_episode(episodes), "food_vs_size": food_vs_size(episodes),
+        "theil": theil_per_episode(episodes), "win_ratio": wins, **bites,
+        "nearest_neighbour": nearest_neighbour(steps), "eod_probability": eod, "episode_summary": summary,
+        "size_tests": pd.concat([spearman(wins, "size", "win_ratio", by="condition").assign(measure="win_ratio"),
+                                 spearman(eod, "size", "eod_probability", by="condition")
+                                 .assign(measure="eod_probability")], ignore_index=True),
+        "condition_tests": dunnett_by_measure(summary, SUMMARY_MEASURES, "condition", control, cfg.analysis.seed),
+    }
+
+
+# ----------------------------------------------------------- interactions
+BITE_OUTPUTS = ("bouts", "chase_sizes", "bite_sizes", "bite_timing", "bite_rate_by_class", "size_tests")
+
+
+def _interactions(t: Tables, cfg: EfishConfig) -> Tables:
+    """Ethogram of pair labels, bouts, chaser and biter sizes, bite timing and rate by class (Figs 3A, 5K-P)."""
+    a, steps = cfg.analysis, t["steps"]
+    labels = {"labels": label_counts(steps, a.facing_rad, a.away_rad)}
+    if lacking := _lacking(steps, ["bite_target"], BITE_OUTPUTS, ["size_tests"]):
+        return {**labels, **lacking}
+    b = bouts(steps, a.bout_cm, a.contact_cm, a.facing_rad, a.away_rad)
+    chases, bites = chase_sizes(steps, bout_table=b), bite_sizes(steps)
+    return {**labels, "bouts": or_nan_row(b, "no bouts"), "chase_sizes": or_nan_row(chases, "no chasing bout"),
+            "bite_sizes": or_nan_row(bites, "no bites"),
+            "bite_timing": or_nan_row(bite_timing(steps, bout_table=b), "no bite within a bout"),
+            "bite_rate_by_class": bite_rate_by_class(steps, a.bout_cm, a.facing_rad, a.away_rad),
+            "size_tests": size_role_tests(chases, bites)}
+
+
+# ----------------------------------------------------------------- homing
+def _homing(t: Tables, cfg: EfishConfig) -> Tables:
+    """Error-angle histograms and time courses, trajectory shape, electric vs ray casting (Fig 2B-D)."""
+    steps = t["steps"]
+    needs_one = [] if set(ERROR_COLUMNS.values()) & set(steps.columns) else ERROR_COLUMNS.values()
+    errors = _lacking(steps, needs_one, ["error_histogram", "error_vs_time"]) or {
+        "error_histogram": error_histogram(steps), "error_vs_time": error_vs_time(steps)}
+    control = control_condition(steps["condition"], cfg)
+    return {**errors, "trajectory_shape": trajectory_shape(steps),
+            "perception": compare_perception(steps, control, None, _homer(cfg))}
+
+
+# --------------------------------------------------------------- onepatch
+def _onepatch(t: Tables, cfg: EfishConfig) -> Tables:
+    """Cumulative food over time and reach rates of the arena's central patch (Fig 5G-J)."""
+    steps, arena = t["steps"], cfg.arena
+    centre = (arena.width_cm / 2, arena.height_cm / 2)
+    return {"food_time_course": food_time_course(steps),
+            "reach_rates": reach_rates(steps, centre, arena.onepatch_radius_cm)}
+
+
+# --------------------------------------------------------------- dynamics
+def _dynamics(t: Tables, cfg: EfishConfig) -> Tables:
+    """Hidden-state dimensionality, power, unit subsampling, decoding, PLSC of agents 0 and 1 (Fig 6)."""
+    a, hidden, steps = cfg.analysis, t["hidden"], t["steps"]
+    rng = np.random.default_rng(a.seed)
+    dims = dynamics_table(hidden, a.variance_fraction, a.spectrogram_window, a.spectrogram_overlap, cfg.env.fps)
+    control = control_condition(dims["condition"], cfg)
+    return {"dimensionality": dims,
+            "subsampling": subsample_table(hidden, a.subsample_fractions, a.subsample_draws, rng),
+            "decoding": decode_table(hidden, steps, folds=a.decode_folds),
+            "plsc": plsc_table(hidden, steps, (0, 1), a.plsc_edges_cm, a.plsc_shifts, rng, a.plsc_percentile),
+            "condition_tests": dunnett_by_measure(dims, DYNAMICS_MEASURES, "condition", control, a.seed)}
+
+
+#: The assays whose food, bites, spacing and EOD probability the behaviour analysis summarises (Figs 3-5).
+FORAGING = ("patchy4", "uniform4", "ablation4", "ablation1", "collective", "mute", "npatch", "food_scarcity",
+            "groupsize", "onepatch")
+ANALYSES: dict[str, Analysis] = {a.name: a for a in [
+    Analysis("signalling", _signalling, ("steps",), ("patchy4", "wide2"),
+             ("idis", "idi_histogram", "power_law", "rate_by_distance", "peri_event", "rate_advantage",
+              "rate_tests"), ("rate_tests",)),
+    Analysis("behaviour", _behaviour, ("steps", "episodes"), FORAGING,
+             ("food_per_agent", "food_vs_size", "theil", "win_ratio", "bite_matrix", "nearest_neighbour",
+              "eod_probability", "episode_summary", "size_tests", "condition_tests"),
+             ("food_vs_size", "size_tests", "condition_tests")),
+    Analysis("interactions", _interactions, ("steps",), ("patchy4", "square2"), ("labels", *BITE_OUTPUTS),
+             ("size_tests",)),
+    Analysis("homing", _homing, ("steps",), ("homing",),
+             ("error_histogram", "error_vs_time", "trajectory_shape", "perception"), ("perception",)),
+    Analysis("onepatch", _onepatch, ("steps",), ("onepatch", "bot"), ("food_time_course", "reach_rates")),
+    Analysis("dynamics", _dynamics, ("hidden", "steps"), ("patchy4", "wide2", "homing", "groupsize", "square2"),
+             ("dimensionality", "subsampling", "decoding", "plsc", "condition_tests"), ("condition_tests",)),
+]}
+
+
+# ------------------------------------------------------------------- API
+def get(name: str) -> Analysis:
+    """The registered analysis ``name``; an unknown name is one ValueError listing the known ones."""
+    if name not in ANALYSES:
+        raise ValueError(f"unknown analysis {name!r}: choose one of {', '.join(ANALYSES)}")
+    return ANALYSES[name]
+
+
+def tables_written(assay: AssayConfig) -> tuple[str, ...]:
+    """The rollout tables an assay writes: steps, episodes, food, and hidden when it sets ``record_hidden``."""
+    return ROLLOUT_TABLES + (("hidden",) if getattr(assay, "record_hidden", False) else ())
+
+
+def analyses_for(assay: str, tables: Iterable[str]) -> list[Analysis]:
+    """The analyses of ``assay`` whose input tables are all among the ``tables`` it writes (what the DAG schedules)."""
+    return [a for a in ANALYSES.values() if assay in a.assays and set(a.reads) <= set(tables)]
+
+
+def read_tables(name: str, folder: str | Path) -> Tables:
+    """The rollout tables analysis ``name`` reads from ``folder``; a missing one is one ValueError naming it."""
+    folder = Path(folder)
+    paths = {t: folder / f"{t}.parquet" for t in get(name).reads}
+    if missing := [str(p) for p in paths.values() if not p.is_file()]:
+        raise ValueError(f"analysis {name!r} needs {', '.join(missing)}, which does not exist (run the assay first)")
+    return {t: read_parquet(p, f"the {t} table") for t, p in paths.items()}
+
+
+def run(name: str, tables: Tables, cfg: EfishConfig) -> Tables:
+    """The output tables of analysis ``name`` (:attr:`Analysis.outputs`, in order) from its input ``tables``."""
+    analysis = get(name)
+    if missing := [t for t in analysis.reads if t not in tables]:
+        raise ValueError(f"analysis {name!r} needs the tables {missing}")
+    out = analysis.compute(tables, cfg)
+    if set(out) != set(analysis.outputs):
+        raise RuntimeError(f"analysis {name!r} returned {sorted(out)}, declared {sorted(analysis.outputs)}")
+    for table in analysis.stats:
+        require(out[table], STAT_COLUMNS, f"statistic table {name}/{table}")
+    return {table: out[table].reset_index(drop=True) for table in analysis.outputs}

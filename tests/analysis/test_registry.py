@@ -1,0 +1,121 @@
+"""The analysis registry: every analysis runs on rollout-shaped tables and writes what it declares."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from efish.analysis.registry import ANALYSES, ROLLOUT_TABLES, analyses_for, get, read_tables, run, tables_written
+from efish.analysis.stats import STAT_COLUMNS
+from efish.config import config_dir
+from efish.rollout.schema import SCHEMAS, to_table
+
+from ..helpers import cfg_with, rollout_tables
+
+#: The assays of SPEC 11 (config/assay/<name>.yaml as they land).
+SPEC_ASSAYS = {"homing", "patchy4", "uniform4", "wide2", "square2", "ablation4", "ablation1", "collective", "mute",
+               "npatch", "food_scarcity", "onepatch", "bot", "groupsize"}
+
+
+def config_for(name: str):
+    """The config an analysis of one of its assays runs under (the homing analysis with the homing assay's)."""
+    return cfg_with("assay=homing") if name == "homing" else cfg_with("scale=smoke")
+
+
+@pytest.fixture(scope="module")
+def tables():
+    return rollout_tables(error_angles=True)
+
+
+def test_the_synthetic_tables_are_shaped_like_the_rollout(tables):
+    for name in SCHEMAS:
+        to_table(tables[name].drop(columns=["bite_target", "err_morm_rad", "err_amp_rad", "err_knollen_rad"],
+                                   errors="ignore"), name)
+
+
+@pytest.mark.parametrize("name", list(ANALYSES))
+def test_every_analysis_writes_its_declared_tables(name, tables):
+    analysis = get(name)
+    homing = {"steps": tables["steps"].query("agent < 2").replace({"condition": {"control": "electric",
+                                                                                  "treated": "raycast"}})}
+    out = run(name, homing if name == "homing" else tables, config_for(name))
+    assert list(out) == list(analysis.outputs)
+    for table, df in out.items():
+        assert isinstance(df, pd.DataFrame) and len(df) > 0, table
+    for table in analysis.stats:
+        assert set(STAT_COLUMNS) <= set(out[table].columns), table
+        assert np.isfinite(out[table]["p"]).any(), f"{name}/{table} has no finite p"
+
+
+def test_statistics_find_the_planted_effects(tables):
+    """Bigger agents eat, bite and discharge more in the synthetic tables; the statistic rows say so."""
+    cfg = cfg_with()
+    behaviour = run("behaviour", tables, cfg)
+    fit = behaviour["food_vs_size"].set_index("group")
+    assert (fit["effect"] > 0).all() and (fit["test"] == "ols").all()
+    sizes = behaviour["size_tests"].set_index(["measure", "group"])
+    assert (sizes.loc["eod_probability", "effect"] > 0.5).all() and (sizes.loc["eod_probability", "p"] < 0.05).all()
+    tests = behaviour["condition_tests"]
+    assert set(tests["measure"]) == {"food_total", "theil_t", "eod_probability", "mean_nn_dist_cm", "bites"}
+    assert (tests["group"] == "treated").all() and (tests["control"] == "control").all()
+    assert (tests["n"] == 3).all() and (tests["n_control"] == 3).all()
+    roles = run("interactions", tables, cfg)["size_tests"].set_index(["measure", "condition"])
+    assert (roles.loc["bite", "group"] == "biter").all() and (roles.loc["bite", "effect"] > 0).all()
+
+
+def test_tables_the_rollout_does_not_record_yet_give_a_reason_not_an_error(tables):
+    steps = tables["steps"].drop(columns="bite_target")
+    out = run("interactions", {"steps": steps}, cfg_with())
+    assert out["labels"]["reason"].eq("").all()
+    for name in ("bouts", "bite_sizes", "size_tests"):
+        assert "bite_target" in out[name].loc[0, "reason"], name
+    assert set(STAT_COLUMNS) <= set(out["size_tests"].columns)
+    assert "bite_target" in run("behaviour", {**tables, "steps": steps}, cfg_with())["bite_matrix"].loc[0, "reason"]
+    electric_only = steps.query("condition == 'control' and agent < 2").assign(condition="electric")
+    homing = run("homing", {"steps": electric_only.drop(columns=["err_morm_rad", "err_amp_rad", "err_knollen_rad"])},
+                 cfg_with("assay=homing"))
+    assert "err_morm_rad" in homing["error_histogram"].loc[0, "reason"]
+    assert homing["perception"]["reason"].eq("no group besides the control").all()  # no raycast condition yet
+
+
+def test_config_values_reach_the_functions(tables, tmp_path):
+    real = tmp_path / "real.csv"
+    pd.DataFrame({"idi_ms": (np.random.default_rng(1).pareto(1.5, 2000) + 1) * 20.0}).to_csv(real, index=False)
+    default = run("signalling", tables, cfg_with())
+    assert default["power_law"].set_index("source").loc["real_fish", "reason"].startswith("no real-fish IDI table")
+    cfg = cfg_with("analysis.rate_bins=4", "analysis.idi_bins=7", f"analysis.real_fish_idis={real}", "env.fps=100")
+    out = run("signalling", tables, cfg)
+    assert out["rate_by_distance"]["bin"].max() <= 3
+    assert out["idi_histogram"].groupby(["source", "condition"], dropna=False).size().eq(7).all()
+    assert np.isfinite(out["power_law"].set_index("source").loc["real_fish", "alpha"])
+    np.testing.assert_allclose(out["idis"]["idi_ms"], out["idis"]["idi_steps"] * 10.0)  # 1000 / env.fps
+
+
+def test_scheduling_follows_the_tables_an_assay_writes():
+    assert [a.name for a in analyses_for("patchy4", ROLLOUT_TABLES)] == ["signalling", "behaviour", "interactions"]
+    with_hidden = tables_written(SimpleNamespace(record_hidden=True))
+    assert "dynamics" in [a.name for a in analyses_for("patchy4", with_hidden)]
+    assert tables_written(cfg_with().assay) == ROLLOUT_TABLES  # no assay records hidden states yet
+
+
+def test_the_registry_names_spec_assays_rollout_tables_and_unique_outputs():
+    shipped = {p.stem for p in (config_dir() / "assay").glob("*.yaml")} - {"selection"}
+    for a in ANALYSES.values():
+        assert set(a.assays) <= SPEC_ASSAYS, a.name
+        assert set(a.reads) <= {*ROLLOUT_TABLES, "hidden"}, a.name
+        assert set(a.stats) <= set(a.outputs) and len(set(a.outputs)) == len(a.outputs), a.name
+        assert not set(a.outputs) & {*SCHEMAS, "hidden"}, a.name  # a rollout table's name means its schema
+    assert shipped <= {s for a in ANALYSES.values() for s in a.assays}  # every shipped assay is analysed
+
+
+def test_bad_names_and_missing_tables_are_one_line(tmp_path, tables):
+    with pytest.raises(ValueError, match="unknown analysis 'nope': choose one of signalling"):
+        get("nope")
+    tables["steps"].to_parquet(tmp_path / "steps.parquet")
+    with pytest.raises(ValueError, match=r"needs .*episodes\.parquet, which does not exist"):
+        read_tables("behaviour", tmp_path)
+    with pytest.raises(ValueError, match=r"needs the tables \['hidden'\]"):
+        run("dynamics", {"steps": tables["steps"]}, cfg_with())
