@@ -164,10 +164,13 @@ def _concat(parts: list[np.ndarray]) -> np.ndarray:
 
 
 def spawn_agents(n: int, width: float, height: float, margin: float, radius: float, rng: np.random.Generator,
-                 max_tries: int = 10_000) -> np.ndarray:
-    """``n`` agent centres uniform in the arena with a wall margin and no overlap (centres >= 2 radii apart)."""
+                 max_tries: int = 10_000, first: np.ndarray | None = None) -> np.ndarray:
+    """``n`` agent centres uniform in the arena with a wall margin and no overlap (centres >= 2 radii apart).
+
+    ``first`` (k, 2): centres already placed; they are kept as the first k rows.
+    """
     lo, hi = (margin, margin), (width - margin, height - margin)
-    xy = np.zeros((0, 2))
+    xy = np.zeros((0, 2)) if first is None else np.asarray(first, dtype=float).reshape(-1, 2)
     for _ in range(max_tries):
         if len(xy) == n:
             return xy

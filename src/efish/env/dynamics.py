@@ -65,14 +65,15 @@ def in_cone(dx, dy, heading, r2_max, cos_half):
 
 @njit(cache=True)
 def eat_and_move(xy, heading, eat_cd, bite_cd, move, turn, bite, v_max, w_max, pellet_xy, alive,
-                 width, height, p, ate, collided, can_bite):
+                 width, height, p, ate, collided, can_bite, eaten):
     """Eating and motion of every agent, in id order, for B arenas (updates arrays in place).
 
     An agent frozen by its eat cooldown neither eats nor moves. Otherwise, unless
     it bites, it eats the nearest live pellet in its eat zone; then it turns and
     moves; a move that would bring two centres closer than the minimum separation
     is cancelled (the turn is kept) and flags a collision; centres are clipped to
-    the walls. Counters count down here; ``can_bite`` reports who may bite.
+    the walls. Counters count down here; ``can_bite`` reports who may bite and
+    ``eaten`` (int64[B, N]) the pellet slot each agent ate, -1 for none.
     """
     b_count, n = xy.shape[0], xy.shape[1]
     for b in range(b_count):
@@ -82,6 +83,7 @@ def eat_and_move(xy, heading, eat_cd, bite_cd, move, turn, bite, v_max, w_max, p
             eat_cd[b, i] = max(eat_cd[b, i] - 1, 0)
             bite_cd[b, i] = max(bite_cd[b, i] - 1, 0)
             ate[b, i] = False
+            eaten[b, i] = -1
             collided[b, i] = False
             if frozen:
                 continue
@@ -96,6 +98,7 @@ def eat_and_move(xy, heading, eat_cd, bite_cd, move, turn, bite, v_max, w_max, p
                 if best_k >= 0:
                     alive[b, best_k] = False
                     ate[b, i] = True
+                    eaten[b, i] = best_k
                     eat_cd[b, i] = int(p[EAT_CD])
             theta = heading[b, i] + turn[b, i] * w_max[b, i]
             theta = (theta + np.pi) % (2 * np.pi) - np.pi
@@ -114,10 +117,11 @@ def eat_and_move(xy, heading, eat_cd, bite_cd, move, turn, bite, v_max, w_max, p
 
 
 @njit(cache=True)
-def resolve_bites(xy, heading, size, bite, can_bite, bite_cd, p, bitten_by, bit, penalty_bitten):
+def resolve_bites(xy, heading, size, bite, can_bite, bite_cd, p, bitten_by, bit, penalty_bitten, target):
     """Simultaneous bites after motion: each willing, able agent bites the nearest agent in its bite zone.
 
-    Writes ``bit`` (bool[B, N]), ``bitten_by`` (int[B, N], how many bites each
+    Writes ``bit`` (bool[B, N]), ``target`` (int64[B, N], the victim of each
+    biter, -1 for none), ``bitten_by`` (int[B, N], how many bites each
     received) and ``penalty_bitten`` (float[B, N], sum of 1 + s_biter - s_victim).
     """
     b_count, n = xy.shape[0], xy.shape[1]
@@ -126,6 +130,7 @@ def resolve_bites(xy, heading, size, bite, can_bite, bite_cd, p, bitten_by, bit,
             bitten_by[b, i] = 0
             penalty_bitten[b, i] = 0.0
             bit[b, i] = False
+            target[b, i] = -1
         for i in range(n):
             if not (bite[b, i] and can_bite[b, i]):
                 continue
@@ -138,6 +143,7 @@ def resolve_bites(xy, heading, size, bite, can_bite, bite_cd, p, bitten_by, bit,
                         best, victim = d2, j
             if victim >= 0:
                 bit[b, i] = True
+                target[b, i] = victim
                 bite_cd[b, i] = int(p[BITE_CD])
                 bitten_by[b, victim] += 1
                 penalty_bitten[b, victim] += 1.0 + size[b, i] - size[b, victim]

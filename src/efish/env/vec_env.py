@@ -105,11 +105,14 @@ class VecEnv:
             self._drive_bots(move, turn, eod)
         old_xy = s.xy.copy()
         ate, collided, can_bite = np.empty(shape, bool), np.empty(shape, bool), np.empty(shape, bool)  # kernel-filled
+        eaten = np.empty(shape, np.int64)
         dyn.eat_and_move(s.xy, s.heading, s.eat_cd, s.bite_cd, move, turn, no_eating, self._v_max, self._w_max,
-                         s.pellet_xy, s.alive, s.width, s.height, self.params, ate, collided, can_bite)
+                         s.pellet_xy, s.alive, s.width, s.height, self.params, ate, collided, can_bite, eaten)
         # 4. bites, simultaneously, on post-move positions (3. sensing happens in _observe)
         bit, bitten_by, penalty = np.empty(shape, bool), np.empty(shape, np.int64), np.empty(shape)  # kernel-filled
-        dyn.resolve_bites(s.xy, s.heading, s.size, bite, can_bite, s.bite_cd, self.params, bitten_by, bit, penalty)
+        bite_target = np.empty(shape, np.int64)
+        dyn.resolve_bites(s.xy, s.heading, s.size, bite, can_bite, s.bite_cd, self.params, bitten_by, bit, penalty,
+                          bite_target)
         # 5. rewards
         d_prev = s.goal_dist.copy()
         self.task.goal_distance(s, s.goal_dist)
@@ -118,7 +121,8 @@ class VecEnv:
         # 6. observations
         dyn.record_motion(s.xy, old_xy, s.heading, move, turn, eod, bite, s.displacement, s.last_action)
         s.was_bitten = bitten_by > 0
-        info = {"ate": ate, "bit": bit, "was_bitten": s.was_bitten.copy(), "bitten_by": bitten_by,
+        info = {"ate": ate, "eaten_slot": eaten, "bit": bit, "bite_target": bite_target,
+                "was_bitten": s.was_bitten.copy(), "bitten_by": bitten_by,
                 "collided": collided, "eod": eod, "move": move, "turn": turn, "bite": bite,
                 "reward_parts": rewards, self.task.distance_key: s.goal_dist.copy()}
         obs = self._observe(eod)

@@ -16,6 +16,7 @@ import numpy as np
 from ...config.schema import ArenaConfig, EfishConfig
 from ..arenas import spawn_agents
 from ..state import EnvState
+from .placement import place_roles
 
 
 @dataclass
@@ -52,8 +53,12 @@ class Task:
         return {}
 
     def place(self, state: EnvState, b: int, arena: ArenaConfig, rng: np.random.Generator) -> None:
-        """Positions and headings of arena ``b`` at reset: ``env.starts`` if given, else uniform without overlap."""
+        """Positions and headings of arena ``b`` at reset: ``env.starts`` if given, else by ``env.roles``
+        (:mod:`.placement`), else uniform without overlap."""
         starts, r = self.cfg.env.starts, self.cfg.physics.agent_radius_cm
+        if self.cfg.env.roles and not starts:
+            place_roles(self.cfg, self.cfg.env.roles, state, b, arena, rng)
+            return
         if starts:
             starts = np.asarray(starts, dtype=float)
             if np.any(starts[:, :2] < r) or np.any(starts[:, :2] > [arena.width_cm - r, arena.height_cm - r]):

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...config.schema import ArenaConfig
 from ..state import EnvState
 from .base import StepEvents, Task
 
@@ -26,6 +27,26 @@ class Homing(Task):
         self.target = np.arange(n_agents) == cfg.env.homing_target
         self.forced_eod = self.target.copy()
         self.bite_allowed = False
+
+    def place(self, state: EnvState, b: int, arena: ArenaConfig, rng: np.random.Generator) -> None:
+        """Target and homers uniform at least ``homing_clearance_cm`` from every wall, each homer at least
+        ``homing_min_distance_cm`` from the target (SPEC 11); fixed ``env.starts`` win; with both
+        constraints 0, the base placement."""
+        e = self.cfg.env
+        if e.starts or not (e.homing_min_distance_cm or e.homing_clearance_cm):
+            super().place(state, b, arena, rng)
+            return
+        clear = max(e.homing_clearance_cm, arena.wall_margin_cm)
+        lo, hi = (clear, clear), (arena.width_cm - clear, arena.height_cm - clear)
+        sep = 2 * self.cfg.physics.agent_radius_cm
+        for _ in range(10_000):
+            xy = rng.uniform(lo, hi, size=(self.n, 2))
+            gaps = np.linalg.norm(xy[:, None] - xy[None], axis=-1) + np.eye(self.n) * 1e9
+            if gaps[self.target][:, ~self.target].min() >= e.homing_min_distance_cm and gaps.min() >= sep:
+                state.xy[b], state.heading[b] = xy, rng.uniform(-np.pi, np.pi, self.n)
+                return
+        raise ValueError(f"no homing start with every homer {e.homing_min_distance_cm:g} cm from the target and "
+                         f"{clear:g} cm from the walls fits a {arena.width_cm:g} x {arena.height_cm:g} cm arena")
 
     def new_state(self, num_envs: int) -> dict[str, np.ndarray]:
         return {"home_steps": np.zeros((num_envs, self.n), np.int64)}  # consecutive steps at home

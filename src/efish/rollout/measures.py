@@ -1,0 +1,162 @@
+"""What the steps table records about each agent at each step, beyond the state itself (SPEC 12, Fig 6 targets).
+
+Pure numpy on an env's state after a step: distances and bearings to the
+nearest bodies, the sizes of the nearest agents, food counts near the agent by
+sector, the realised turn, how many conspecifics the Knollenorgans hear, and
+the physics quantities the analyses must not recompute (error angles of a
+homer against its target's local fields; log10 of the Mormyromast- and
+Ampullary-relevant fields at the body centre). Every function returns arrays
+[B, N] keyed by their column names.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..config.schema import EfishConfig
+from ..env.geometry import nearest_pellet
+from ..env.vec_env import VecEnv
+from ..physics.fields import coulomb_constant
+
+CM = 0.01  # m per cm
+SECTORS = ("front", "left", "back", "right")  # bearing within pi/4 of 0, pi/2, pi, -pi/2
+
+
+def wrap(a: np.ndarray) -> np.ndarray:
+    """Angles wrapped to [-pi, pi)."""
+    return (a + np.pi) % (2 * np.pi) - np.pi
+
+
+def nearest(env: VecEnv) -> dict[str, np.ndarray]:
+    """Distance (cm) and bearing (rad, from the heading) to the nearest agent, pellet and wall; the distance to
+    the second-nearest agent and the sizes of the nearest two (NaN where there is none)."""
+    s = env.state
+    xy, h = s.xy, s.heading
+    d = xy[:, None, :, :] - xy[:, :, None, :]                       # [B, N(i), N(j), 2]: j - i
+    dist = np.linalg.norm(d, axis=-1) + np.where(np.eye(env.n, dtype=bool), np.inf, 0.0)
+    order = np.argsort(dist, axis=-1, kind="stable")
+    j = order[..., 0]
+    pick = np.take_along_axis(d, j[..., None, None], axis=2)[:, :, 0]
+    out = {"dist_agent_cm": dist.min(axis=-1), "bearing_agent_rad": wrap(np.arctan2(pick[..., 1], pick[..., 0]) - h)}
+    sizes = np.broadcast_to(s.size[:, None, :], dist.shape)
+    for rank, key in ((0, "1"), (1, "2")):
+        has = env.n > rank + 1
+        k = order[..., min(rank, env.n - 1)]
+        out[f"size_agent{key}"] = np.take_along_axis(sizes, k[..., None], -1)[..., 0] if has else np.full(h.shape, np.nan)
+    out["dist_agent2_cm"] = np.sort(dist, axis=-1)[..., 1] if env.n > 2 else np.full(h.shape, np.nan)
+    if env.n == 1:
+        out["dist_agent_cm"][:], out["bearing_agent_rad"][:] = np.nan, np.nan
+    dist_food, k = np.empty(h.shape), np.empty(h.shape, np.int64)
+    nearest_pellet(xy, s.pellet_xy, s.alive, dist_food, k)
+    pk = np.take_along_axis(s.pellet_xy, np.maximum(k, 0)[..., None], axis=1) - xy   # [B, N, 2]
+    out["dist_food_cm"] = dist_food
+    out["bearing_food_rad"] = np.where(k >= 0, wrap(np.arctan2(pk[..., 1], pk[..., 0]) - h), np.nan)
+    walls = np.stack([xy[..., 0], s.width[:, None] - xy[..., 0], xy[..., 1], s.height[:, None] - xy[..., 1]], -1)
+    w = walls.argmin(axis=-1)
+    out["dist_wall_cm"] = walls.min(axis=-1)
+    out["bearing_wall_rad"] = wrap(np.array([np.pi, 0.0, -np.pi / 2, np.pi / 2])[w] - h)
+    return out
+
+
+def food_counts(env: VecEnv, radius_cm: float = 5.0) -> dict[str, np.ndarray]:
+    """Live pellets within ``radius_cm`` of each agent, in all and per sector of the bearing from the heading."""
+    s = env.state
+    d = s.pellet_xy[:, None, :, :] - s.xy[:, :, None, :]             # [B, N, P, 2]
+    near = (np.einsum("bnpi,bnpi->bnp", d, d) <= radius_cm ** 2) & s.alive[:, None, :]
+    bearing = wrap(np.arctan2(d[..., 1], d[..., 0]) - s.heading[..., None])
+    sector = np.round(bearing / (np.pi / 2)).astype(int) % 4           # 0 front, 1 left, 2 back, 3 right
+    out = {"food_count_5cm": near.sum(-1)}
+    for k, name in enumerate(SECTORS):
+        out[f"food_{name}_5cm"] = (near & (sector == k)).sum(-1)
+    return out
+
+
+def knollen_agents(knollen_block: np.ndarray, slots: int) -> np.ndarray:
+    """Conspecifics heard: slots of the Knollenorgan observation block [B, N, slots * K] with any spike."""
+    b, n, width = knollen_block.shape
+    return (knollen_block.reshape(b, n, slots, width // slots) != 0).any(-1).sum(-1)
+
+
+def eod_field(xy_m: np.ndarray, heading: np.ndarray, at_m: np.ndarray, cfg: EfishConfig) -> np.ndarray:
+    """Direct EOD field (V/m) of emitters at ``xy_m`` [..., 2] with ``heading`` [...] at points ``at_m`` [..., 2]."""
+    ph = cfg.physics
+    k, q, half = coulomb_constant(ph.eps0), ph.eod_charge_c, ph.eod_half_separation_cm * CM
+    u = np.stack([np.cos(heading), np.sin(heading)], -1) * half
+    e = np.zeros(np.broadcast_shapes(xy_m.shape, at_m.shape))
+    for sign in (1.0, -1.0):
+        d = at_m - (xy_m + sign * u)
+        r2 = (d * d).sum(-1) + ph.softening_m ** 2
+        e += sign * k * q * d / r2[..., None] ** 1.5
+    return e
+
+
+def dipole_at(p: np.ndarray, source_m: np.ndarray, at_m: np.ndarray, cfg: EfishConfig) -> np.ndarray:
+    """Field (V/m) of dipoles ``p`` [..., 2] at ``source_m`` [..., 2] at points ``at_m`` [..., 2]."""
+    k = coulomb_constant(cfg.physics.eps0)
+    d = at_m - source_m
+    r2 = (d * d).sum(-1) + cfg.physics.softening_m ** 2
+    p_dot_d = (p * d).sum(-1)
+    return k * (3.0 * d * (p_dot_d / r2 ** 2.5)[..., None] - p / r2[..., None] ** 1.5)
+
+
+def angle_of(e: np.ndarray) -> np.ndarray:
+    return np.arctan2(e[..., 1], e[..., 0])
+
+
+def homing_errors(env: VecEnv) -> dict[str, np.ndarray]:
+    """Heading minus the direction of the target's local field at each homer, per receptor class (SPEC 13, Fig 2C).
+
+    Knollenorgan: the target's direct EOD field; Ampullary: its intrinsic dipole's
+    field; Mormyromast: the field of the dipole the homer's own EOD induces on
+    the target (the homer taken as emitting: a property of the geometry). Free
+    space (no wall images), at the homer's centre. NaN for the target itself and
+    in tasks without a target.
+    """
+    s, cfg = env.state, env.cfg
+    shape = s.heading.shape
+    target = getattr(env.task, "target", None)
+    if target is None or not target.any():
+        return {f"err_{c}_rad": np.full(shape, np.nan) for c in ("morm", "amp", "knollen")}
+    t = int(np.flatnonzero(target)[0])
+    xy, h = s.xy * CM, s.heading
+    txy, th = xy[:, t:t + 1], h[:, t:t + 1]                           # [B, 1, 2], [B, 1]
+    ph = cfg.physics
+    e_knollen = eod_field(txy, th, xy, cfg)
+    p_intrinsic = ph.agent_dipole_cm * np.stack([np.cos(th), np.sin(th)], -1)
+    e_amp = dipole_at(p_intrinsic, txy, xy, cfg)
+    alpha = (ph.agent_radius_cm * CM) ** 3 * ph.susceptibility / coulomb_constant(ph.eps0)
+    p_induced = alpha * eod_field(xy, h, np.broadcast_to(txy, xy.shape), cfg)   # each homer's EOD at the target
+    e_morm = dipole_at(p_induced, txy, xy, cfg)
+    out = {}
+    for name, e in (("morm", e_morm), ("amp", e_amp), ("knollen", e_knollen)):
+        err = wrap(h - angle_of(e))
+        err[:, t] = np.nan
+        out[f"err_{name}_rad"] = err
+    return out
+
+
+def log_fields(env: VecEnv) -> dict[str, np.ndarray]:
+    """log10 |E| (V/m) at each agent's centre of what each electroreceptor class senses (decoding targets).
+
+    Ampullary: the intrinsic dipoles of every other body; Mormyromast: the
+    dipoles the agent's own EOD induces on every other body. Free space, live
+    pellets only; -inf where the field is exactly 0.
+    """
+    s, ph = env.state, env.cfg.physics
+    xy, h = s.xy * CM, s.heading
+    bodies = np.concatenate([xy, s.pellet_xy * CM], axis=1)             # [B, N + P, 2]
+    n = env.n
+    live = np.concatenate([np.ones(xy.shape[:2], bool), s.alive], axis=1)
+    p_int = np.concatenate([ph.agent_dipole_cm * np.stack([np.cos(h), np.sin(h)], -1),
+                            ph.pellet_dipole_cm * np.stack([-np.sin(s.pellet_phi), np.cos(s.pellet_phi)], -1)], 1)
+    radius = np.concatenate([np.full(xy.shape[:2], ph.agent_radius_cm), np.full(s.alive.shape, ph.pellet_radius_cm)],
+                            axis=1) * CM
+    alpha = radius ** 3 * ph.susceptibility / coulomb_constant(ph.eps0)   # [B, N + P]
+    centre = xy[:, :, None, :]                                            # [B, N, 1, 2]
+    others = live[:, None, :] & ~np.eye(n, bodies.shape[1], dtype=bool)[None]
+    e_amp = dipole_at(p_int[:, None], bodies[:, None], centre, env.cfg)                  # [B, N, N + P, 2]
+    e_eod = eod_field(xy[:, :, None, :], h[:, :, None], bodies[:, None], env.cfg)        # own EOD at every body
+    e_morm = dipole_at(alpha[:, None, :, None] * e_eod, bodies[:, None], centre, env.cfg)
+    with np.errstate(divide="ignore"):
+        return {name: np.log10(np.linalg.norm((e * others[..., None]).sum(2), axis=-1))
+                for name, e in (("log_amp_field", e_amp), ("log_morm_field", e_morm))}
