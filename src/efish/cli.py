@@ -3,7 +3,8 @@
     efish config [overrides]                  print the resolved config
     efish plan [overrides]                    which effects run, and why
     efish train [overrides] [--out D]         train one seed (checkpoint.pt, metrics.parquet, final.pt)
-    efish assay [overrides] --policy P        run an assay into steps/episodes/food.parquet
+    efish assay [overrides] --policy P...     run an assay into steps/episodes/food(/hidden).parquet
+    efish schema steps|episodes|food|hidden   the columns of a rollout table and what they mean
     efish select --episodes F... --out D      rank seeds, write the ranking and the chosen seed
     efish analyze NAME [overrides] --tables D --out D   one analysis of an assay's tables -> <table>.parquet
     efish figure FIG[/PANEL] [overrides]      draw a panel (or a figure's page) from the result tables
@@ -45,8 +46,13 @@ def _parser() -> argparse.ArgumentParser:
     tr.add_argument("--restart", action="store_true", help="discard a checkpoint in --out and start afresh")
     asy = sub.add_parser("assay", help="run an assay with a trained policy into Parquet tables")
     asy.add_argument("overrides", nargs="*")
-    asy.add_argument("--policy", type=Path, required=True, help="training folder, final.pt or checkpoint.pt")
+    asy.add_argument("--policy", nargs="+", required=True, metavar="[NAME=]PATH",
+                     help="training folder, final.pt or checkpoint.pt of each policy the conditions act with "
+                          "(NAME: selected, homing, homing_raycast, ...; a bare PATH is the assay's own policy)")
     asy.add_argument("--out", type=Path, help="output folder (default results/{scale}/assays/{assay})")
+    sch = sub.add_parser("schema", help="print the columns of a rollout table with their meaning")
+    sch.add_argument("table", choices=("steps", "episodes", "food", "hidden"))
+    sch.add_argument("overrides", nargs="*")
     sel = sub.add_parser("select", help="rank seeds from their evaluation episodes (SPEC 10)")
     sel.add_argument("overrides", nargs="*", help="config overrides, recorded in config.yaml (e.g. scale=laptop)")
     sel.add_argument("--episodes", nargs="+", type=Path, required=True,
@@ -164,12 +170,27 @@ def _assay(args, cfg, started) -> None:
     from .rollout.assay import run_assay
     from .rollout.tables import write_tables
 
-    policy = load_policy(args.policy)
+    paths = policy_paths(args.policy, cfg.assay.policy)
+    policies = {name: load_policy(path) for name, path in paths.items()}
     out = args.out or _run_folder(cfg, args) / "assays" / cfg.assay.name
-    tables = run_assay(args.overrides, policy)
+    tables, stats = run_assay(args.overrides, policies, progress=lambda c: print(f"condition {c} done",
+                                                                                  file=sys.stderr, flush=True))
     write_tables(tables, out)
-    _metadata(out, cfg, started, args, policy=str(args.policy))
-    print(f"wrote {', '.join(f'{k}.parquet ({len(v)} rows)' for k, v in tables.items())} to {out}")
+    _metadata(out, cfg, started, args, policies={k: str(v) for k, v in paths.items()}, **stats)
+    print(f"wrote {', '.join(f'{k}.parquet ({len(v)} rows)' for k, v in tables.items())} to {out} "
+          f"({stats['env_steps_per_s']:,.0f} env-steps/s)")
+
+
+def policy_paths(entries: list[str], default: str) -> dict[str, Path]:
+    """``--policy`` entries ``NAME=PATH`` (or a bare ``PATH`` for the assay's own policy, ``default``)."""
+    paths = {}
+    for entry in entries:
+        name, sep, path = entry.partition("=")
+        name, path = (name, path) if sep else (default, entry)
+        if name in paths:
+            raise ValueError(f"--policy names {name!r} twice")
+        paths[name] = Path(path)
+    return paths
 
 
 def _select(args, cfg, started) -> None:
@@ -279,6 +300,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             _select(args, cfg, started)
         elif args.command == "config":
             print(to_yaml(cfg), end="")
+        elif args.command == "schema":
+            from .rollout.schema import describe
+
+            print(describe(args.table))
         elif args.command == "train":
             _train(args, cfg, started)
         elif args.command == "assay":

@@ -56,7 +56,7 @@ def write_parquet_tables(tables: dict[str, Any], folder: str | os.PathLike) -> l
         for name, table in tables.items():
             tmp = stack.enter_context(atomic_path(folder / f"{name}.parquet", commit=False))
             arrow = table if isinstance(table, pa.Table) else pa.Table.from_pandas(table, preserve_index=False)
-            pq.write_table(arrow, tmp)
+            pq.write_table(arrow, tmp, compression="zstd")
             staged[name] = tmp
         for name, tmp in staged.items():
             os.replace(tmp, folder / f"{name}.parquet")

@@ -1,11 +1,11 @@
-# Assays (SPEC 11): one job per assay writes its steps, episodes and food tables.
-# An assay is a file config/assay/<name>.yaml; its `policy` key says which
-# trained policy acts (the selected seed, or the homing policy).
+# Assays (SPEC 11): one job per assay writes its steps, episodes and food tables (and hidden.parquet where the
+# assay sets record_hidden). An assay is a file config/assay/<name>.yaml; each condition's `assay.policy` says which
+# trained policy acts (the selected seed, or a recipe of config/policy/), and the job gets every one it needs.
 
 
 rule assay:
     input:
-        policy=assay_policy,
+        unpack(assay_policies_input),
     output:
         steps="results/{run}/assays/{assay}/steps.parquet",
         episodes="results/{run}/assays/{assay}/episodes.parquet",
@@ -17,9 +17,58 @@ rule assay:
     params:
         overrides=ARGS,
         out=folder_of("steps"),
+        policies=policy_args,
+    wildcard_constraints:
+        assay="|".join(a for a in ASSAYS if a not in HIDDEN_ASSAYS) or "^$",
     threads: 1
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish assay assay={wildcards.assay} {params.overrides} --policy {input.policy} "
+        "efish assay assay={wildcards.assay} {params.overrides} --policy {params.policies} "
         "--out {params.out} > {log} 2>&1"
+
+
+use rule assay as assay_with_hidden with:
+    output:
+        steps="results/{run}/assays/{assay}/steps.parquet",
+        episodes="results/{run}/assays/{assay}/episodes.parquet",
+        food="results/{run}/assays/{assay}/food.parquet",
+        hidden="results/{run}/assays/{assay}/hidden.parquet",
+    wildcard_constraints:
+        assay="|".join(HIDDEN_ASSAYS) or "^$",
+
+
+# The supplement's top-3 panels: the best-ranked seeds also run scale.top_seed_assays.
+rule top_seed_assay:
+    input:
+        "results/{run}/train/seed_{seed}/final.pt",
+    output:
+        steps="results/{run}/seeds/seed_{seed}/assays/{assay}/steps.parquet",
+        episodes="results/{run}/seeds/seed_{seed}/assays/{assay}/episodes.parquet",
+        food="results/{run}/seeds/seed_{seed}/assays/{assay}/food.parquet",
+    log:
+        "results/{run}/logs/seeds/seed_{seed}/{assay}.log",
+    benchmark:
+        "results/{run}/benchmarks/seeds/seed_{seed}/{assay}.tsv"
+    params:
+        overrides=ARGS,
+        out=folder_of("steps"),
+    threads: 1
+    conda:
+        "../envs/efish.yaml"
+    shell:
+        "efish assay assay={wildcards.assay} {params.overrides} --policy selected={input} "
+        "--out {params.out} > {log} 2>&1"
+
+
+rule top_seeds:
+    input:
+        top_seed_targets,
+    output:
+        "results/{run}/seeds/done.txt",
+    log:
+        "results/{run}/logs/seeds/done.log",
+    conda:
+        "../envs/efish.yaml"
+    shell:
+        "printf '%s\\n' {input} > {output} 2> {log}"

@@ -6,7 +6,9 @@ import sys
 from pathlib import Path
 
 from efish.analysis.registry import ANALYSES, analyses_for, tables_written
-from efish.config import ConfigError, compose, run_name
+from efish.config import ConfigError, compose, config_dir, run_name
+from efish.env.observe import observation_size
+from efish.rollout.assay import check_observation_sizes, condition_configs, policies_needed
 from efish.figures.registry import PANELS, panels_for
 from efish.figures.render import input_paths
 
@@ -51,6 +53,28 @@ def assay_config(name):
 
 
 ASSAYS = [assay_config(name).assay.name for name in CFG.scale.assays]
+POLICY_RECIPES = sorted(p.stem for p in (config_dir() / "policy").glob("*.yaml"))
+
+
+def assay_policies(name):
+    """Policy name -> conditions of assay ``name``; every condition composes, its policy exists and its observation
+    fits that policy: checked here, so bad input stops before any job with one line naming it."""
+    try:
+        configs = condition_configs([f"scale={SCALE}", *OVERRIDES, f"assay={name}"])
+        needed = policies_needed(configs)
+        unknown = sorted(set(needed) - {"selected", *POLICY_RECIPES})
+        if unknown:
+            raise ValueError(f"assay {name} asks for policies {', '.join(unknown)}: choose selected or one of "
+                             f"{', '.join(POLICY_RECIPES)} (files in config/policy/)")
+        sizes = {p: observation_size(efish_config(*([] if p == "selected" else [f"policy={p}"]))) for p in needed}
+        check_observation_sizes(configs, sizes)
+    except (ConfigError, ValueError) as exc:
+        fail(str(exc))
+    return needed
+
+
+ASSAY_POLICIES = {name: assay_policies(name) for name in ASSAYS}
+HIDDEN_ASSAYS = [name for name in ASSAYS if assay_config(name).assay.record_hidden]
 # The analyses of each assay of the scale whose tables it writes (dynamics waits for assay.record_hidden).
 ASSAY_ANALYSES = {name: analyses_for(name, tables_written(assay_config(name).assay)) for name in ASSAYS}
 DRAWABLE = panels_for(ASSAYS)
@@ -90,11 +114,30 @@ def selected_policy(wildcards):
     return f"results/{wildcards.run}/train/seed_{seed}/final.pt"
 
 
-def assay_policy(wildcards):
-    """The policy an assay's config asks for: the homing policy, or the selected foraging seed."""
-    if assay_config(wildcards.assay).assay.policy == "homing":
-        return f"results/{wildcards.run}/train/homing/final.pt"
-    return selected_policy(wildcards)
+def assay_policies_input(wildcards):
+    """The final checkpoint of every policy an assay's conditions act with, by policy name."""
+    return {name: selected_policy(wildcards) if name == "selected" else f"results/{wildcards.run}/train/{name}/final.pt"
+            for name in ASSAY_POLICIES[wildcards.assay]}
+
+
+def policy_args(wildcards, input):
+    """efish assay's --policy entries: NAME=PATH for every input policy."""
+    return " ".join(f"{name}={path}" for name, path in input.items())
+
+
+def top_seeds(wildcards):
+    """The ``scale.top_seeds`` best-ranked seeds, from the select_seed checkpoint's ranking table."""
+    import pandas as pd
+
+    ranking = pd.read_parquet(checkpoints.select_seed.get(run=wildcards.run).output.ranking)
+    return [int(s) for s in ranking["seed"].head(CFG.scale.top_seeds)]
+
+
+def top_seed_targets(wildcards):
+    """Tables of the top seeds' assays (supplement): results/{run}/seeds/seed_{n}/assays/{assay}/."""
+    return [f"results/{wildcards.run}/seeds/seed_{seed}/assays/{assay}/{table}.parquet"
+            for seed in top_seeds(wildcards) for assay in CFG.scale.top_seed_assays
+            for table in ("steps", "episodes", "food")]
 
 
 def panel_of(wildcards):
@@ -114,6 +157,9 @@ def all_targets():
         f"figures/{RUN}/bench/bench_accuracy.pdf",
     ]
     targets += [f"results/{RUN}/assays/{a}/{t}.parquet" for a in ASSAYS for t in ("steps", "episodes", "food")]
+    targets += [f"results/{RUN}/assays/{a}/hidden.parquet" for a in HIDDEN_ASSAYS]
+    if CFG.scale.top_seeds:
+        targets.append(f"results/{RUN}/seeds/done.txt")
     targets += [path for a, analyses in ASSAY_ANALYSES.items() for an in analyses
                 for path in analysis_outputs(an, RUN, a).values()]
     targets += [f"figures/{RUN}/{p.figure}/{p.name}.{ext}" for p in DRAWABLE for ext in ("png", "pdf")]

@@ -1,5 +1,5 @@
-# Training: every foraging seed of the scale, and the homing policy
-# (config/policy/homing.yaml composes its task, arenas and training). efish train
+# Training: every foraging seed of the scale, and every policy recipe an assay asks for
+# (config/policy/<name>.yaml composes its task, arenas and training: homing, homing_raycast). efish train
 # checkpoints beside the declared output and writes final.pt atomically at the
 # end, so a killed job is rerun and resumes from its last checkpoint.
 
@@ -23,20 +23,22 @@ rule train:
         "{params.overrides} --out {params.out} > {log} 2>&1"
 
 
-rule train_homing:
+rule train_policy:
     output:
-        final="results/{run}/train/homing/final.pt",
-        metrics="results/{run}/train/homing/metrics.parquet",
+        final="results/{run}/train/{policy}/final.pt",
+        metrics="results/{run}/train/{policy}/metrics.parquet",
     log:
-        "results/{run}/logs/train/homing.log",
+        "results/{run}/logs/train/{policy}.log",
     benchmark:
-        "results/{run}/benchmarks/train/homing.tsv"
+        "results/{run}/benchmarks/train/{policy}.tsv"
     params:
         overrides=ARGS,
         out=folder_of("final"),
+    wildcard_constraints:
+        policy="|".join(POLICY_RECIPES),
     threads: 1
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish train policy=homing train.threads={threads} "
+        "efish train policy={wildcards.policy} train.threads={threads} "
         "{params.overrides} --out {params.out} > {log} 2>&1"

@@ -257,9 +257,10 @@ class AssayConfig:
     episodes: int = param(30, "episodes per condition", lo=1)
     seed: int = param(1000, "seed of the evaluation episodes (held out from training)", lo=0)
     deterministic: bool = param(True, "thresholded EOD/bite and Gaussian means instead of samples")
-    policy: str = param("selected", "which trained policy acts: the selected foraging seed or the homing policy",
-                        choices=("selected", "homing"))
+    policy: str = param("selected", "which trained policy acts: the selected foraging seed, or a policy recipe of "
+                                    "config/policy/ (homing, homing_raycast); a condition may set its own")
     conditions: dict = param({}, "condition name -> list of config overrides (set by each assay file)")
+    record_hidden: bool = param(False, "also write hidden.parquet: the policy's GRU state per step and agent")
 
 
 # ----------------------------------------------------------------------- bench
@@ -295,7 +296,12 @@ class ScaleConfig:
     homing_rollout_steps: int = param(800, "steps per homing rollout", lo=1)
     max_episodes: int = param(8, "cap on the episodes per assay condition (SPEC 11 counts at paper scale)", lo=1)
     selection_episodes: int = param(8, "patchy4 episodes per seed for seed selection (SPEC 10)", lo=1)
-    assays: list = param(["patchy4", "homing"], "assays the pipeline runs (names of config/assay/*.yaml)")
+    max_episode_steps: int = param(100_000, "cap on an assay episode's length (the smoke scale shortens them)", lo=1)
+    top_seeds: int = param(3, "the best-ranked seeds that also run the top_seed_assays (supplement)", lo=0)
+    top_seed_assays: list = param(["patchy4", "wide2", "square2"], "assays the top seeds run")
+    assays: list = param(["homing", "patchy4", "uniform4", "wide2", "square2", "ablation4", "ablation1",
+                          "collective", "mute", "npatch", "food_scarcity", "onepatch", "bot", "groupsize"],
+                         "assays the pipeline runs (names of config/assay/*.yaml)")
 
 
 # -------------------------------------------------------------------- analysis

@@ -1,24 +1,74 @@
-"""``run_assay``: every condition of an assay config, one table set (SPEC 11)."""
+"""``run_assay``: every condition of an assay config, each batched in one env, one table set (SPEC 11)."""
 
 from __future__ import annotations
 
-from typing import Sequence
+import dataclasses
+import time
+from typing import Callable, Mapping, Sequence
 
 import pandas as pd
 
-from ..config import compose
+from ..config import ConfigError, compose
+from ..config.schema import EfishConfig
+from ..env.observe import observation_size
 from .run import run_episodes
 
 
-def run_assay(overrides: Sequence[str], policy) -> dict[str, pd.DataFrame]:
-    """Compose the assay's config with ``overrides``, run each condition (its own overrides on top)
-    for ``min(assay.episodes, scale.max_episodes)`` episodes, and return the concatenated ``steps``,
-    ``episodes``, ``food`` tables."""
+def condition_configs(overrides: Sequence[str]) -> dict[str, EfishConfig]:
+    """Each condition's config: the assay's, with the condition's overrides on top and the scale's caps on
+    episode length applied. A condition whose overrides do not compose is one clear error naming it."""
     base = compose(list(overrides))
-    parts = []
+    configs = {}
     for name, extra in base.assay.conditions.items():
-        cfg = compose(list(overrides) + list(extra))
+        try:
+            cfg = compose(list(overrides) + list(extra))
+        except ConfigError as exc:
+            raise ConfigError(f"assay {base.assay.name}, condition {name}: {exc}") from None
+        steps = min(cfg.env.episode_steps, cfg.scale.max_episode_steps)
+        configs[name] = dataclasses.replace(cfg, env=dataclasses.replace(cfg.env, episode_steps=steps))
+    return configs
+
+
+def policies_needed(configs: Mapping[str, EfishConfig]) -> dict[str, list[str]]:
+    """Policy name -> the conditions it acts in."""
+    needed: dict[str, list[str]] = {}
+    for name, cfg in configs.items():
+        needed.setdefault(cfg.assay.policy, []).append(name)
+    return needed
+
+
+def check_observation_sizes(configs: Mapping[str, EfishConfig], sizes: Mapping[str, int]) -> None:
+    """One clear error when a condition's observation does not fit its policy (``sizes``: policy -> input size)."""
+    for name, cfg in configs.items():
+        want, got = sizes[cfg.assay.policy], observation_size(cfg)
+        if want != got:
+            raise ValueError(f"assay {cfg.assay.name}, condition {name}: its observation has {got} values but "
+                             f"policy {cfg.assay.policy!r} takes {want} (another perception or layout)")
+
+
+def run_assay(overrides: Sequence[str], policies: Mapping, progress: Callable | None = None
+              ) -> tuple[dict[str, pd.DataFrame], dict]:
+    """Run every condition for ``min(assay.episodes, scale.max_episodes)`` episodes in parallel arenas.
+
+    ``policies``: policy name (``selected``, ``homing``, ...) -> a policy with ``obs_dim``, ``initial_hidden``
+    and ``act`` (:class:`efish.rl.policy.Policy`). Returns the concatenated tables (``hidden`` too when
+    ``assay.record_hidden``) and run statistics (env steps, seconds, env-steps/s). Everything is checked
+    before the first step: unknown policies and observation sizes that do not fit.
+    """
+    configs = condition_configs(overrides)
+    missing = sorted(set(policies_needed(configs)) - set(policies))
+    if missing:
+        raise ValueError(f"the assay needs policies {', '.join(missing)}: pass --policy NAME=PATH for each")
+    check_observation_sizes(configs, {k: p.obs_dim for k, p in policies.items()})
+    parts, env_steps, start = [], 0, time.perf_counter()
+    for name, cfg in configs.items():
         episodes = min(cfg.assay.episodes, cfg.scale.max_episodes)
-        parts.append(run_episodes(cfg, policy, episodes, condition=name, seed=cfg.assay.seed,
-                                  deterministic=cfg.assay.deterministic))
-    return {k: pd.concat([p[k] for p in parts], ignore_index=True) for k in parts[0]}
+        part = run_episodes(cfg, policies[cfg.assay.policy], episodes, condition=name, seed=cfg.assay.seed,
+                            deterministic=cfg.assay.deterministic, record_hidden=cfg.assay.record_hidden)
+        env_steps += int(part["episodes"].groupby("episode")["steps"].max().sum())
+        parts.append(part)
+        if progress:
+            progress(name)
+    seconds = time.perf_counter() - start
+    tables = {k: pd.concat([p[k] for p in parts], ignore_index=True) for k in parts[0]}
+    return tables, {"env_steps": env_steps, "seconds": seconds, "env_steps_per_s": env_steps / seconds}
