@@ -36,20 +36,21 @@ def run_episodes(cfg: EfishConfig, policy, episodes: int, condition: str = "cont
         obs, reward, term, trunc, info = env.step(actions)
         food.update(env, alive_before, t, running, info["eaten_slot"])
         rows = np.repeat(running, N)
-        steps.append(pd.DataFrame(step_columns(env, obs, reward, term, info, heading_before, t))[rows])
+        steps.append({k: v[rows] for k, v in step_columns(env, obs, reward, term, info, heading_before, t).items()})
         if record_hidden:
-            states.append(hidden_rows(hidden, t)[rows])
+            states.append(hidden.reshape(B * N, -1)[rows].astype(np.float32))
         bites_recv += info["bitten_by"] * running[:, None]
         starts = np.zeros(B)
         running &= ~(term | trunc)
         if not running.any():
             break
-    steps_df = pd.concat(steps, ignore_index=True)
+    # one frame per table at the end: building a frame per step costs more than the step itself
+    steps_df = pd.DataFrame({k: np.concatenate([step[k] for step in steps]) for k in steps[0]})
     steps_df.insert(0, "condition", condition)
     steps_df.insert(3, "t_ms", steps_df["t"] * 1000.0 / cfg.env.fps)
     tables = {"steps": steps_df, "episodes": episode_table(steps_df, bites_recv), "food": food.table()}
     if record_hidden:
-        tables["hidden"] = pd.concat(states, ignore_index=True)
+        tables["hidden"] = hidden_table(steps_df[["episode", "t", "agent"]], np.concatenate(states))
     for name in ("food", "hidden"):
         if name in tables:
             tables[name].insert(0, "condition", condition)
@@ -85,13 +86,10 @@ def step_columns(env: VecEnv, obs: np.ndarray, reward: np.ndarray, term: np.ndar
     return {k: np.ravel(v) for k, v in columns.items()}
 
 
-def hidden_rows(hidden: np.ndarray, t: int) -> pd.DataFrame:
-    """The GRU state [B, N, H] of one step as rows keyed by episode, t and agent (float32 columns h_0...)."""
-    B, N, H = hidden.shape
-    keys = pd.DataFrame({"episode": np.repeat(np.arange(B), N), "t": np.full(B * N, t),
-                         "agent": np.tile(np.arange(N), B)})
-    units = pd.DataFrame(hidden.reshape(B * N, H).astype(np.float32), columns=[f"h_{i}" for i in range(H)])
-    return pd.concat([keys, units], axis=1)
+def hidden_table(keys: pd.DataFrame, hidden: np.ndarray) -> pd.DataFrame:
+    """The GRU states [rows, H] beside their keys (episode, t, agent), float32 columns h_0 ... h_{H-1}."""
+    units = pd.DataFrame(hidden, columns=[f"h_{i}" for i in range(hidden.shape[1])])
+    return pd.concat([keys.reset_index(drop=True), units], axis=1)
 
 
 def episode_table(steps: pd.DataFrame, bites_received: np.ndarray) -> pd.DataFrame:
