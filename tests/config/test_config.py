@@ -161,3 +161,21 @@ def test_yaml_files_set_only_what_differs_from_the_schema(path):
             if isinstance(value, str) and value.startswith("${"):
                 continue  # an interpolation: read from another group, not a copy
             assert value != _default(group, key), f"{path.name}: {group}.{key}={value!r} repeats the schema default"
+
+
+@pytest.mark.parametrize("assay", ["mute", "npatch", "homing", "bot"])
+def test_compose_variants_equals_composing_each_condition_in_full(assay):
+    from efish.config.compose import compose_variants
+
+    base = compose([f"assay={assay}", "scale=smoke"])
+    fast = compose_variants([f"assay={assay}", "scale=smoke"])
+    assert list(fast) == list(base.assay.conditions)
+    for name, extra in base.assay.conditions.items():
+        assert to_yaml(fast[name]) == to_yaml(compose([f"assay={assay}", "scale=smoke", *extra])), name
+
+
+def test_a_bad_variant_is_one_line_naming_it():
+    from efish.config.compose import compose_variants
+
+    with pytest.raises(ConfigError, match=r"^condition x: unknown config key 'env.nonsense'$"):
+        compose_variants(["assay=mute"], {"x": ["env.nonsense=1"]}, label="condition")

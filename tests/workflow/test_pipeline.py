@@ -125,7 +125,7 @@ def test_overrides_reach_every_efish_call(tmp_path):
 @pytest.mark.parametrize("config, target, message", [
     (["overrides=physics.tolerance=-1"], [], "efish config: physics.tolerance=-1.0 is out of range"),
     (["overrides=physics.nonsense=1"], [], "efish config: unknown config key 'physics.nonsense'"),
-    ([], ["results/smoke/assays/nope/steps.parquet"], "unknown assay 'nope'"),
+    (["overrides=scale.assays=[nope]"], [], "unknown assay 'nope'"),
 ])
 def test_bad_input_fails_before_any_job(tmp_path, config, target, message):
     result = dry_run(tmp_path, *target, "--config", "scale=smoke", *config)
@@ -248,3 +248,21 @@ def test_the_readme_override_example_reruns_cleanly_beside_the_default_run(smoke
     assert "Nothing to be done" in result.stdout + result.stderr  # the second attempt reuses the first's outputs
     after = {p: p.stat().st_mtime_ns for p in (smoke_run / "results/smoke").glob("**/*") if p.is_file()}
     assert after == before
+
+
+@pytest.mark.parametrize("conditions, message", [
+    ('{control: ["env.nonsense=1"]}', "condition control: unknown config key 'env.nonsense'"),
+    ('{rays: ["sensors.perception=raycast"]}', "condition rays: its observation has 83 values but policy 'selected'"),
+    ('{other: ["assay.policy=nope"]}', "asks for policies nope"),
+])
+def test_a_bad_assay_condition_stops_before_any_job_in_one_line(tmp_path, conditions, message):
+    shutil.copytree(REPO / "config", tmp_path / "config")
+    (tmp_path / "config/assay/bad.yaml").write_text(
+        "# @package _global_\nassay:\n  name: bad\n  conditions: " + conditions + "\n")
+    result = subprocess.run(["snakemake", "-n", "--cores", "1", "--snakefile", str(REPO / "Snakefile"),
+                             "--directory", str(tmp_path), "--config", "scale=smoke", "overrides=scale.assays=[bad]"],
+                            capture_output=True, text=True, timeout=300, env=smoke_env(tmp_path))
+    assert result.returncode != 0
+    last = result.stderr.strip().splitlines()[-1]
+    assert last.startswith("efish workflow: assay bad") and message in last, result.stderr[-2000:]
+    assert not (tmp_path / "results").exists()

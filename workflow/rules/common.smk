@@ -1,11 +1,15 @@
 # Shared settings: the scale and its efish config, read once. Every number the
 # rules need (seeds, assays, panels) comes from efish's config; none is repeated here.
+import functools
+import hashlib
+import json
 import re
 import shlex
 import sys
 from pathlib import Path
 
 from efish.analysis.registry import ANALYSES, analyses_for, tables_written
+from efish._numba_cache import source_digest
 from efish.config import ConfigError, compose, config_dir, run_name
 from efish.env.observe import observation_size
 from efish.rollout.assay import check_observation_sizes, condition_configs, policies_needed
@@ -33,9 +37,10 @@ if not re.fullmatch(r"[A-Za-z0-9_.\-]+", RUN):
     fail(f"run={RUN!r} is not a folder name: use letters, digits, '_', '.' and '-'")
 
 
+@functools.lru_cache(maxsize=None)
 def efish_config(*overrides):
-    """The validated efish config at this scale with the user's overrides; bad input stops the workflow
-    before any job runs, with efish's one-line message."""
+    """The validated efish config at this scale with the user's overrides (composed once per override set);
+    bad input stops the workflow before any job runs, with efish's one-line message."""
     try:
         return compose([f"scale={SCALE}", *OVERRIDES, *overrides])
     except ConfigError as exc:
@@ -73,7 +78,23 @@ def assay_policies(name):
     return needed
 
 
-ASSAY_POLICIES = {name: assay_policies(name) for name in ASSAYS}
+def checked_assays():
+    """``assay_policies`` of every assay, cached in .snakemake/efish/ under a hash of the config tree, the efish
+    sources, the scale and the overrides: composing every condition costs seconds, and each Snakemake call
+    (each cluster job too) reads this file again."""
+    digest = hashlib.sha256(repr((SCALE, OVERRIDES, ASSAYS, source_digest())).encode())
+    for path in sorted(config_dir().rglob("*.yaml")):
+        digest.update(path.read_bytes())
+    cache = Path(".snakemake/efish") / f"assays-{digest.hexdigest()[:16]}.json"
+    if cache.is_file():
+        return json.loads(cache.read_text())
+    checked = {name: assay_policies(name) for name in ASSAYS}
+    cache.parent.mkdir(parents=True, exist_ok=True)
+    cache.write_text(json.dumps(checked))
+    return checked
+
+
+ASSAY_POLICIES = checked_assays()
 HIDDEN_ASSAYS = [name for name in ASSAYS if assay_config(name).assay.record_hidden]
 # The analyses of each assay of the scale whose tables it writes (dynamics waits for assay.record_hidden).
 ASSAY_ANALYSES = {name: analyses_for(name, tables_written(assay_config(name).assay)) for name in ASSAYS}

@@ -45,6 +45,82 @@ def _register_schemas() -> None:
     _SCHEMA_REGISTERED = True
 
 
+def _hydra_compose(overrides: Sequence[str]):
+    """The composed, unresolved DictConfig (Hydra's compose API); every failure one ConfigError line."""
+    from hydra import compose as hydra_compose
+    from hydra import initialize_config_dir
+    from hydra.core.global_hydra import GlobalHydra
+
+    _register_schemas()
+    GlobalHydra.instance().clear()
+    try:
+        with initialize_config_dir(config_dir=str(config_dir()), version_base=None, job_name="efish"):
+            return hydra_compose(config_name="config", overrides=list(overrides))
+    except Exception as exc:  # Hydra and OmegaConf raise many types; all mean "bad config"
+        raise ConfigError(one_line_message(exc)) from None
+    finally:
+        GlobalHydra.instance().clear()
+
+
+def _to_config(raw) -> EfishConfig:
+    from omegaconf import OmegaConf
+
+    try:
+        cfg = OmegaConf.to_object(raw)
+    except Exception as exc:
+        raise ConfigError(one_line_message(exc)) from None
+    validate(cfg)
+    return cfg
+
+
+def compose_variants(overrides: Sequence[str], variants: dict[str, Sequence[str]] | None = None,
+                     label: str = "variant") -> dict[str, EfishConfig]:
+    """``compose(overrides + variant)`` for every variant, composing with Hydra only once.
+
+    ``variants`` defaults to the composed config's own ``assay.conditions``.
+
+    Hydra's compose costs about 0.13 s; an assay's conditions (30 for the bot
+    assay) are mostly plain ``key=value`` overrides, which are applied to a copy
+    of the composed config exactly as Hydra applies them. A variant that
+    chooses a config group (``arena=npatch``) or adds or deletes keys is
+    composed in full. Errors are one :class:`ConfigError` line naming the
+    variant (``<label> <name>: ...``).
+    """
+    from hydra.core.override_parser.overrides_parser import OverridesParser
+
+    base = _hydra_compose(overrides)
+    if variants is None:
+        variants = _to_config(base).assay.conditions
+    groups = {p.name for p in config_dir().iterdir() if p.is_dir()}
+    parser = OverridesParser.create()
+    out = {}
+    for name, extra in variants.items():
+        try:
+            out[name] = _variant(base, parser, groups, overrides, extra)
+        except ConfigError as exc:
+            raise ConfigError(f"{label} {name}: {exc}") from None
+    return out
+
+
+def _variant(base, parser, groups: set[str], overrides: Sequence[str], extra: Sequence[str]) -> EfishConfig:
+    """One variant of :func:`compose_variants`: Hydra's plain updates on a copy, or a full composition."""
+    from omegaconf import OmegaConf
+
+    try:
+        parsed = parser.parse_overrides(list(extra))
+    except Exception as exc:
+        raise ConfigError(one_line_message(exc)) from None
+    if any(o.is_add() or o.is_delete() or o.is_force_add() or o.key_or_group in groups or o.package for o in parsed):
+        return compose(list(overrides) + list(extra))
+    raw = base.copy()  # still in struct mode: an unknown key is an error, as in Hydra
+    try:
+        for o in parsed:
+            OmegaConf.update(raw, o.key_or_group, o.value(), merge=True)
+    except Exception as exc:
+        raise ConfigError(one_line_message(exc)) from None
+    return _to_config(raw)
+
+
 def compose(overrides: Sequence[str] = ()) -> EfishConfig:
     """Compose ``config/config.yaml`` with Hydra overrides into a validated :class:`EfishConfig`.
 
@@ -52,25 +128,7 @@ def compose(overrides: Sequence[str] = ()) -> EfishConfig:
     >>> cfg.physics.image_order
     2
     """
-    from hydra import compose as hydra_compose
-    from hydra import initialize_config_dir
-    from hydra.core.global_hydra import GlobalHydra
-    from omegaconf import OmegaConf
-
-    _register_schemas()
-    GlobalHydra.instance().clear()
-    try:
-        with initialize_config_dir(config_dir=str(config_dir()), version_base=None, job_name="efish"):
-            raw = hydra_compose(config_name="config", overrides=list(overrides))
-        cfg = OmegaConf.to_object(raw)
-    except ConfigError:
-        raise
-    except Exception as exc:  # Hydra and OmegaConf raise many types; all mean "bad config"
-        raise ConfigError(one_line_message(exc)) from None
-    finally:
-        GlobalHydra.instance().clear()
-    validate(cfg)
-    return cfg
+    return _to_config(_hydra_compose(overrides))
 
 
 def one_line_message(exc: BaseException) -> str:

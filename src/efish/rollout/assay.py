@@ -8,7 +8,7 @@ from typing import Callable, Mapping, Sequence
 
 import pandas as pd
 
-from ..config import ConfigError, compose
+from ..config.compose import compose_variants
 from ..config.schema import EfishConfig
 from ..env.observe import observation_size
 from .run import run_episodes
@@ -17,16 +17,10 @@ from .run import run_episodes
 def condition_configs(overrides: Sequence[str]) -> dict[str, EfishConfig]:
     """Each condition's config: the assay's, with the condition's overrides on top and the scale's caps on
     episode length applied. A condition whose overrides do not compose is one clear error naming it."""
-    base = compose(list(overrides))
-    configs = {}
-    for name, extra in base.assay.conditions.items():
-        try:
-            cfg = compose(list(overrides) + list(extra))
-        except ConfigError as exc:
-            raise ConfigError(f"assay {base.assay.name}, condition {name}: {exc}") from None
-        steps = min(cfg.env.episode_steps, cfg.scale.max_episode_steps)
-        configs[name] = dataclasses.replace(cfg, env=dataclasses.replace(cfg.env, episode_steps=steps))
-    return configs
+    name = next((o.split("=", 1)[1] for o in reversed(overrides) if o.startswith("assay=")), "")
+    configs = compose_variants(overrides, label=f"assay {name}, condition".replace("assay ,", "assay,"))
+    return {name: dataclasses.replace(cfg, env=dataclasses.replace(
+        cfg.env, episode_steps=min(cfg.env.episode_steps, cfg.scale.max_episode_steps))) for name, cfg in configs.items()}
 
 
 def policies_needed(configs: Mapping[str, EfishConfig]) -> dict[str, list[str]]:
