@@ -106,7 +106,7 @@ def rollout_tables(seed: int = 0, conditions=("control", "treated"), episodes: i
                 **{f"h_{i}": h[:, i].astype(np.float32) for i in range(units)}))
             food.append(pd.DataFrame({"condition": cond, "episode": e, "pellet": np.arange(5),
                                       "x_cm": rng.uniform(0, arena_cm, 5), "y_cm": rng.uniform(0, arena_cm, 5),
-                                      "t_spawned": 0, "t_eaten": -1}))
+                                      "t_spawned": 0, "t_eaten": -1, "eaten_by": -1}))
     s = pd.concat(frames, ignore_index=True)
     if not bite_target:
         s = s.drop(columns="bite_target")
@@ -140,7 +140,14 @@ def _episode_steps(rng, cond: str, episode: int, n: int, steps: int, arena_cm: f
             "dist_food_cm": rng.uniform(0, 12, (steps, n)), "bearing_food_rad": rng.uniform(-np.pi, np.pi, (steps, n)),
             "dist_wall_cm": wall, "bearing_wall_rad": rng.uniform(-np.pi, np.pi, (steps, n)),
             "morm_abs_mean": rng.random((steps, n)), "amp_abs_mean": rng.random((steps, n)),
-            "knollen_spikes": rng.integers(0, 12, (steps, n)), "bite_target": np.where(bit, nearest, -1)}
+            "knollen_spikes": rng.integers(0, 12, (steps, n)), "bite_target": np.where(bit, nearest, -1),
+            "turn_rad": rng.uniform(-0.3, 0.3, (steps, n)), "dist_agent2_cm": np.sort(d, axis=-1)[..., min(1, n - 1)],
+            "size_agent1": size[nearest], "size_agent2": np.full((steps, n), np.nan),
+            **{f"food_{k}5cm": rng.integers(0, 3, (steps, n)) for k in ("count_", "front_", "left_", "back_",
+                                                                       "right_")},
+            "n_knollen_agents": rng.integers(0, n, (steps, n)), "log_morm_field": rng.normal(-6, 1, (steps, n)),
+            "log_amp_field": rng.normal(-10, 1, (steps, n)),
+            **{f"err_{c}_rad": np.full((steps, n), np.nan) for c in ("morm", "amp", "knollen")}}
     t, agent = np.repeat(np.arange(steps), n), np.tile(np.arange(n), steps)
     return pd.DataFrame({"condition": cond, "episode": episode, "t": t, "t_ms": t * 1000.0 / 83.0, "agent": agent,
                          "x_cm": xy[..., 0].ravel(), "y_cm": xy[..., 1].ravel(),

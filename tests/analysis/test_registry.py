@@ -31,9 +31,8 @@ def tables():
 
 
 def test_the_synthetic_tables_are_shaped_like_the_rollout(tables):
-    for name in SCHEMAS:
-        to_table(tables[name].drop(columns=["bite_target", "err_morm_rad", "err_amp_rad", "err_knollen_rad"],
-                                   errors="ignore"), name)
+    for name in (*SCHEMAS, "hidden"):
+        to_table(tables[name], name)
 
 
 @pytest.mark.parametrize("name", list(ANALYSES))
@@ -98,7 +97,8 @@ def test_scheduling_follows_the_tables_an_assay_writes():
     assert [a.name for a in analyses_for("patchy4", ROLLOUT_TABLES)] == ["signalling", "behaviour", "interactions"]
     with_hidden = tables_written(SimpleNamespace(record_hidden=True))
     assert "dynamics" in [a.name for a in analyses_for("patchy4", with_hidden)]
-    assert tables_written(cfg_with().assay) == ROLLOUT_TABLES  # no assay records hidden states yet
+    assert tables_written(cfg_with("assay=mute").assay) == ROLLOUT_TABLES
+    assert "hidden" in tables_written(cfg_with("assay=patchy4").assay)
 
 
 def test_the_registry_names_spec_assays_rollout_tables_and_unique_outputs():

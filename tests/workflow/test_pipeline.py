@@ -105,7 +105,8 @@ def test_the_recorded_command_reproduces_an_assay(smoke_run, tmp_path):
     out = args.index("--out")
     args[out + 1] = str(tmp_path / "again")
     policy = args.index("--policy")
-    args[policy + 1] = str(smoke_run / args[policy + 1])
+    name, path = args[policy + 1].split("=", 1)
+    args[policy + 1] = f"{name}={smoke_run / path}"
     result = subprocess.run(["efish", *args], capture_output=True, text=True, timeout=300, env=smoke_env(smoke_run))
     assert result.returncode == 0, result.stderr
     assert (tmp_path / "again/config.yaml").read_text() == (folder / "config.yaml").read_text()
