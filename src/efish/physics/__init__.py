@@ -11,10 +11,11 @@ task. Modules, from the formulas up:
 - ``readings``: :class:`RawReadings`, the result of both paths below.
 - ``reference``: the brute-force oracle (numpy, every source at every sensor); tests and accuracy studies only.
 - ``fast``: the fast path's Python side: plan -> kernel inputs, batch -> raw readings.
+- ``kernel_inputs``: the named tuples the kernels take (plan tables, batch arrays, outputs, scratch arrays).
 - ``kernels``: numba field kernels shared by the fast path (monopoles, sensor placement, induction, far points).
 - ``far_field``: the far-field tables: trigonometric interpolation from a few points on the sensor circle.
 - ``sources``: source lists of an arena, culling bounds, sharing far sources between agents, bucketing.
-- ``sense_kernel``: the per-agent and per-batch assembly of raw readings (numba).
+- ``sense_kernel``: the per-batch and per-agent assembly of raw readings (numba).
 - ``trig``: a vectorised sincos for the kernels.
 """
 

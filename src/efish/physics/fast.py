@@ -1,4 +1,4 @@
-"""Python side of the fast path: plan -> kernel constants, batch -> kernel arrays."""
+"""Python side of the fast path: plan -> :class:`PlanTables` (once per plan), batch -> raw readings."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ import numpy as np
 
 from . import kernels as kn
 from .far_field import flat_far_tables, level_tables
+from .kernel_inputs import BatchArrays, Outputs, PlanTables
 from .plan import CM, EffectPlan
 from .readings import RawReadings, empty_readings
 from .sense_kernel import sense_batch_kernel
@@ -46,10 +47,10 @@ def kernel_constants(plan: EffectPlan) -> tuple[np.ndarray, np.ndarray]:
     return c.astype(dtype), f
 
 
-_PREPARED: "weakref.WeakKeyDictionary[EffectPlan, tuple]" = weakref.WeakKeyDictionary()
+_PREPARED: "weakref.WeakKeyDictionary[EffectPlan, PlanTables]" = weakref.WeakKeyDictionary()
 
 
-def prepared_inputs(plan: EffectPlan) -> tuple:
+def prepared_inputs(plan: EffectPlan) -> PlanTables:
     """Everything the batch kernel needs from a plan, in the kernel dtype; built once per plan."""
     if plan not in _PREPARED:
         dtype = np.dtype(plan.dtype)
@@ -59,14 +60,16 @@ def prepared_inputs(plan: EffectPlan) -> tuple:
 
         c, flags = kernel_constants(plan)
         angles = (plan.morm_angles, plan.amp_angles)
-        tables = np.zeros((4, max(len(a) for a in angles)))
+        trig = np.zeros((4, max(len(a) for a in angles)))
         for row, a in enumerate(angles):
-            tables[2 * row, :len(a)], tables[2 * row + 1, :len(a)] = np.cos(a), np.sin(a)
-        _PREPARED[plan] = (
-            plan.image_indices, arr(plan.image_weights), c, flags, arr(tables),
-            np.array(plan.far_levels, dtype=np.int64), *level_tables(plan),
-            *(arr(t) if t.dtype.kind == "f" else t for t in flat_far_tables(plan)),
-            arr(np.cos(plan.knollen_angles)), arr(np.sin(plan.knollen_angles)))
+            trig[2 * row, :len(a)], trig[2 * row + 1, :len(a)] = np.cos(a), np.sin(a)
+        level_lcq, level_e = level_tables(plan)
+        far_offsets, far_points, interp_m, interp_a = flat_far_tables(plan)
+        _PREPARED[plan] = PlanTables(
+            img_idx=plan.image_indices, img_w=arr(plan.image_weights), c=c, c32=c.astype(np.float32), flags=flags,
+            sensor_trig=arr(trig), levels=np.array(plan.far_levels, dtype=np.int64), level_lcq=level_lcq,
+            level_e=level_e, far_offsets=far_offsets, far_points=arr(far_points), interp_m=arr(interp_m),
+            interp_a=arr(interp_a), cos_k=arr(np.cos(plan.knollen_angles)), sin_k=arr(np.sin(plan.knollen_angles)))
     return _PREPARED[plan]
 
 
@@ -77,11 +80,9 @@ def fast_raw(batch: SnapshotBatch, plan: EffectPlan) -> RawReadings:
     out = empty_readings(b, n, plan, dtype)
     if not plan.on("fields"):
         return out
-    inputs = prepared_inputs(plan)
-    flags = inputs[3]
-    if not (flags[kn.DO_MORM] or flags[kn.DO_AMP] or flags[kn.DO_KNOLL]):
+    tables = prepared_inputs(plan)
+    if not (tables.flags[kn.DO_MORM] or tables.flags[kn.DO_AMP] or tables.flags[kn.DO_KNOLL]):
         return out
-    emitting = np.ascontiguousarray(batch.agent_emitting & plan.on("eod_emission"))
 
     def arr(x, scale=None):  # the input itself when it already fits; scaled in float64, then cast
         if scale is None:
@@ -89,8 +90,11 @@ def fast_raw(batch: SnapshotBatch, plan: EffectPlan) -> RawReadings:
         scaled = np.multiply(x, scale, dtype=np.float64, order="C")
         return scaled if dtype == np.float64 else scaled.astype(dtype)
 
-    sense_batch_kernel(
-        arr(batch.agent_xy, CM), arr(batch.agent_heading), emitting,
-        arr(batch.pellet_xy, CM), arr(batch.pellet_orientation), np.ascontiguousarray(batch.pellet_alive),
-        arr(batch.width, CM), arr(batch.height, CM), *inputs, out.mormyromast, out.ampullary, out.knollenorgan)
+    arrays = BatchArrays(
+        agent_xy=arr(batch.agent_xy, CM), heading=arr(batch.agent_heading),
+        emitting=np.ascontiguousarray(batch.agent_emitting & plan.on("eod_emission")),
+        pellet_xy=arr(batch.pellet_xy, CM), pellet_phi=arr(batch.pellet_orientation),
+        pellet_alive=np.ascontiguousarray(batch.pellet_alive), width=arr(batch.width, CM), height=arr(batch.height, CM))
+    outputs = Outputs(out.mormyromast, out.ampullary, out.knollenorgan)
+    sense_batch_kernel(tuple(arrays), tuple(tables), tuple(outputs))  # plain tuples pass faster, see the kernel
     return out

@@ -1,4 +1,18 @@
-"""Per-agent assembly of raw readings in numba: exact and interpolated sources, Knollenorgans.
+"""Per-batch and per-agent assembly of raw readings in numba: exact and interpolated sources, Knollenorgans.
+
+:func:`sense_batch_kernel` names its inputs and runs :func:`sense_arenas`: per
+arena :func:`fill_bodies` (agents, live pellets, padding), the induced moments and
+their sum T1 (:func:`t1_moments`), the source list (far pellet images shared
+between agents by :func:`efish.physics.sources.share_far_sources`) and
+:func:`knollenorgan_env`; per agent the agent's Mormyromast moments and
+:func:`sense_agent` (culling and bucketing in
+:func:`efish.physics.sources.gather_sources`, then exact and interpolated
+readings). Inputs and scratch arrays are the named tuples of
+:mod:`efish.physics.kernel_inputs` (shapes there; ``DT`` is the working dtype).
+A kernel that calls others counts a reference (an atomic operation) for every
+array of every tuple it is passed and every field it reads, so kernels called
+per arena or per agent take only the parts they use, and the arena steps are
+written out in :func:`sense_arenas` rather than in helpers of their own.
 
 Sources (every body and its wall images) carry two moment columns, the
 combined Mormyromast moment and the intrinsic (Ampullary) moment; which are
@@ -29,6 +43,7 @@ import numpy as np
 
 from .._jit import njit
 from .geometry import slot_agent
+from .kernel_inputs import Arena, BatchArrays, Bodies, Lists, Outputs, PlanTables, SourceList, Staging, Workspace
 from .kernels import (
     _FASTMATH,
     ALPHA_AGENT,
@@ -90,6 +105,10 @@ from .sources import (
 )
 from .trig import sincos
 
+# Rows of the arena's body table ``Bodies.body``: position, polarisability, the agent's
+# Mormyromast moment (full list), the Ampullary moment, T1 (shared mode).
+B_X, B_Y, B_ALPHA, B_M1X, B_M1Y, B_M2X, B_M2Y, B_T1X, B_T1Y, N_BODY = range(10)
+
 
 @njit(cache=True)
 def mormyromast_weights(a, emitting, c):
@@ -141,8 +160,10 @@ def own_eod_images(out, xy, heading, img, c, sx, sy, nx, ny):
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def knollenorgan_env(axy, heading, emitting, cos_k, sin_k, c, flags, out):
-    """out[a, slot] = direct EOD field of the slot's conspecific at a's sensors, no images."""
+def knollenorgan_env(arena, plan, out):
+    """out[a, slot] (DT[N, N - 1, S_k]) = direct EOD field of the slot's conspecific at a's sensors, no images."""
+    axy, heading, emitting, c, cull, cos_k, sin_k = (arena.axy, arena.heading, arena.emitting, plan.c,
+                                                      plan.flags[CULL], plan.cos_k, plan.sin_k)
     n, s_count = axy.shape[0], cos_k.shape[0]
     sx, sy = np.empty(s_count, c.dtype), np.empty(s_count, c.dtype)
     nx, ny = np.empty(s_count, c.dtype), np.empty(s_count, c.dtype)
@@ -155,7 +176,7 @@ def knollenorgan_env(axy, heading, emitting, cos_k, sin_k, c, flags, out):
                 continue
             # Mean-value bound on the pair field: |E| <= 2 h * 2 k q / (D - r - h)^3.
             gap = np.sqrt((axy[j, 0] - axy[a, 0]) ** 2 + (axy[j, 1] - axy[a, 1]) ** 2) - c[R_SENS] - c[HALF_SEP]
-            if flags[CULL] and gap > 0 and 4.0 * kq * c[HALF_SEP] / gap ** 3 <= c[KNOLL_ZERO]:
+            if cull and gap > 0 and 4.0 * kq * c[HALF_SEP] / gap ** 3 <= c[KNOLL_ZERO]:
                 continue  # every spike would be 0 after binarisation
             ux = c[HALF_SEP] * np.cos(heading[j])
             uy = c[HALF_SEP] * np.sin(heading[j])
@@ -197,176 +218,216 @@ def interpolate_add(out, matrix, values, lo, hi):
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def sense_agent(a, axy, heading, emitting, n_list, lst, own, n_shared, shared_tot, img, c, c32, flags, tables,
-                levels, level_lcq, level_e, far_offsets, far_points, interp_m, interp_a, geo, in_dense, order, dense,
-                exact, far, offsets, scratch, scratch32, out_m, out_a):
-    """Mormyromast and Ampullary raw readings of agent ``a``.
+def sense_agent(a, arena, srcs, plan, stage, out_m, out_a):
+    """Mormyromast (out_m, DT[S_m]) and Ampullary (out_a, DT[S_a]) raw readings of agent ``a`` of ``arena``.
 
-    The first ``n_list`` columns of ``lst`` and ``own`` list the sources that
-    are not shared, with ``a``'s Mormyromast moments in ``geo`` (see
-    :func:`efish.physics.sources.gather_sources`); ``dense[:, :n_shared]``
-    holds the shared ones as ``a`` evaluates them, ``shared_tot`` their bound
-    sums in both columns.
-    ``tables`` rows 0-1 / 2-3: cos, sin of Mormyromast / Ampullary angles.
-    ``scratch`` rows 0-3: sensor x, y, nx, ny; rows 4-5: readings at the points of
-    every level (``scratch32``: the same in float32 for the interpolated sources,
-    ``c32`` the constants in float32); level l owns points
-    ``far_offsets[l]:far_offsets[l + 1]`` of ``far_points`` and rows of ``interp_m/a``.
+    ``srcs`` lists the sources that are not shared, with ``a``'s Mormyromast
+    moments in ``stage.geo``; :func:`~efish.physics.sources.gather_sources`
+    stages them, after the shared ones in ``stage.dense[:, :srcs.n_shared]``. A
+    class whose bound sum shows that every normalised reading would be 0 is
+    skipped. Exact sources are added at the sensors (``stage.sensors`` rows 0-3:
+    x, y, nx, ny), the others read at their level's points (``stage.points32``)
+    and interpolated; level l owns points ``plan.far_offsets[l]`` up to ``[l + 1]``.
     """
+    c, flags, trig = plan.c, plan.flags, plan.sensor_trig
+    sens, pts, offsets = stage.sensors, stage.points32, stage.offsets
     sm, sa = out_m.shape[0], out_a.shape[0]
-    ax, ay = axy[a, 0], axy[a, 1]
+    ax, ay, heading = arena.axy[a, 0], arena.axy[a, 1], arena.heading[a]
     thr1 = c[TOL_MORM] if flags[CULL] else -1.0
     thr2 = c[TOL_AMP] if flags[CULL] else -1.0
-    n_dense, tot1, tot2 = gather_sources(a, n_list, ax, ay, lst, own, thr1, thr2, c, level_lcq, level_e, n_shared,
-                                         geo, in_dense, order, dense, exact, far, offsets)
-    tot1 += shared_tot[0]
-    tot2 += shared_tot[1]
-    walls = flags[DO_WALLDIST] and emitting[a] and img.shape[0] > 1 and c[G_SELF] != 0
+    n_dense, tot1, tot2 = gather_sources(a, ax, ay, thr1, thr2, srcs, c, plan.level_lcq, plan.level_e, stage)
+    tot1 += srcs.bound_m  # plus the shared sources' bounds
+    tot2 += srcs.bound_a
+    walls = flags[DO_WALLDIST] and arena.emitting[a] and arena.img.shape[0] > 1 and c[G_SELF] != 0
     do_m = flags[DO_MORM] and (walls or not flags[CULL] or tot1 > c[ZERO_MORM])
     do_a = flags[DO_AMP] and (not flags[CULL] or tot2 > c[ZERO_AMP])
-    sx, sy, nx, ny = scratch[0], scratch[1], scratch[2], scratch[3]
+    sx, sy, nx, ny = sens[0], sens[1], sens[2], sens[3]
     if do_m:
-        place_sensors(ax, ay, heading[a], tables[0, :sm], tables[1, :sm], c[R_SENS], sx[:sm], sy[:sm], nx[:sm], ny[:sm])
-        add_sources(out_m, exact, offsets[1], M1X, M1Y, sx[:sm], sy[:sm], nx[:sm], ny[:sm], c)
+        place_sensors(ax, ay, heading, trig[0, :sm], trig[1, :sm], c[R_SENS], sx[:sm], sy[:sm], nx[:sm], ny[:sm])
+        add_sources(out_m, stage.exact, offsets[1], M1X, M1Y, sx[:sm], sy[:sm], nx[:sm], ny[:sm], c)
         if walls:
-            own_eod_images(out_m, axy[a], heading[a], img, c, sx[:sm], sy[:sm], nx[:sm], ny[:sm])
+            own_eod_images(out_m, arena.axy[a], heading, arena.img, c, sx[:sm], sy[:sm], nx[:sm], ny[:sm])
     if do_a:
-        place_sensors(ax, ay, heading[a], tables[2, :sa], tables[3, :sa], c[R_SENS], sx[:sa], sy[:sa], nx[:sa], ny[:sa])
-        add_sources(out_a, exact, offsets[1], M2X, M2Y, sx[:sa], sy[:sa], nx[:sa], ny[:sa], c)
+        place_sensors(ax, ay, heading, trig[2, :sa], trig[3, :sa], c[R_SENS], sx[:sa], sy[:sa], nx[:sa], ny[:sa])
+        add_sources(out_a, stage.exact, offsets[1], M2X, M2Y, sx[:sa], sy[:sa], nx[:sa], ny[:sa], c)
     if not (do_m or do_a) or (offsets[-1] == offsets[1] and n_dense == 0):
         return
     # the points of every level at once: one cos/sin of the heading per agent
+    c32, far_offsets, dense, far, interp_m, interp_a = (plan.c32, plan.far_offsets, stage.dense, stage.far,
+                                                       plan.interp_m, plan.interp_a)
     n_pts = far_offsets[-1]
-    px, py, pnx, pny = scratch32[0, :n_pts], scratch32[1, :n_pts], scratch32[2, :n_pts], scratch32[3, :n_pts]
-    place_on_circle(np.float32(0.0), np.float32(0.0), np.float32(np.cos(heading[a])), np.float32(np.sin(heading[a])),
-                    far_points[0], far_points[1], c32[R_SENS], px, py, pnx, pny)
-    for lv in range(levels.shape[0]):
+    px, py, pnx, pny = pts[0, :n_pts], pts[1, :n_pts], pts[2, :n_pts], pts[3, :n_pts]
+    place_on_circle(np.float32(0.0), np.float32(0.0), np.float32(np.cos(heading)), np.float32(np.sin(heading)),
+                    plan.far_points[0], plan.far_points[1], c32[R_SENS], px, py, pnx, pny)
+    for lv in range(plan.levels.shape[0]):
         lo, hi = far_offsets[lv], far_offsets[lv + 1]
         # interpolated sources are evaluated in float32 (twice the SIMD width, far
         # cheaper sqrt and division); positions relative to the agent keep it precise
         if lv == 0:
-            far_readings(dense, 0, n_dense, px[lo:hi], py[lo:hi], pnx[lo:hi], pny[lo:hi], c32,
-                         scratch32[4, lo:hi], scratch32[5, lo:hi])
+            far_readings(dense, 0, n_dense, px[lo:hi], py[lo:hi], pnx[lo:hi], pny[lo:hi], c32, pts[4, lo:hi],
+                         pts[5, lo:hi])
         elif offsets[lv + 2] > offsets[lv + 1]:
             far_readings(far, offsets[lv + 1], offsets[lv + 2], px[lo:hi], py[lo:hi], pnx[lo:hi], pny[lo:hi], c32,
-                         scratch32[4, lo:hi], scratch32[5, lo:hi])
+                         pts[4, lo:hi], pts[5, lo:hi])
         else:
             continue  # an empty level adds nothing
-        scratch[4, lo:hi] = scratch32[4, lo:hi]
-        scratch[5, lo:hi] = scratch32[5, lo:hi]
+        sens[4, lo:hi] = pts[4, lo:hi]
+        sens[5, lo:hi] = pts[5, lo:hi]
         if do_m:
-            interpolate_add(out_m, interp_m, scratch[4], lo, hi)
+            interpolate_add(out_m, interp_m, sens[4], lo, hi)
         if do_a:
-            interpolate_add(out_a, interp_a, scratch[5], lo, hi)
+            interpolate_add(out_a, interp_a, sens[5], lo, hi)
 
 
 @njit(cache=True, error_model="numpy")
-def sense_batch_kernel(agent_xy, heading, emitting, pellet_xy, pellet_phi, pellet_alive, width, height,
-                       img_idx, img_w, c, flags, tables, levels, level_lcq, level_e, far_offsets, far_points,
-                       interp_m, interp_a, cos_k, sin_k,
-                       out_m, out_a, out_k):
-    """Raw readings for B arenas. Positions in m, in the dtype of ``c``; outputs zeroed by the caller.
-
-    Bodies are the agents (first N), then the live pellets of each arena, then
-    inert padding. Their images are listed once per arena; when every agent
-    weighs self and cons induced moments alike (g_self = g_cons), the pellet
-    images far from every agent are shared by all agents
-    (:func:`efish.physics.sources.share_far_sources`).
-    """
-    b_count, n = agent_xy.shape[0], agent_xy.shape[1]
-    nb_max = n + (pellet_xy.shape[1] if flags[DO_PELLETS] else 0)
+def make_workspace(batch, plan):
+    """The scratch arrays of one call (:class:`~efish.physics.kernel_inputs.Workspace`), sized for the fullest arena."""
+    c, n, n_pel = plan.c, batch.agent_xy.shape[1], batch.pellet_xy.shape[1]
+    nb_max = n + (n_pel if plan.flags[DO_PELLETS] else 0)
     nb_max = -(-nb_max // BLOCK) * BLOCK  # room for the inert padding bodies
-    cap = nb_max * img_idx.shape[0]
-    padded = cap + BLOCK * (levels.shape[0] + 1)  # room for every bucket's padding
-    exact = np.empty((N_SRC, padded), c.dtype)
-    far = np.empty((N_SRC, padded), np.float32)
-    offsets = np.zeros(levels.shape[0] + 2, np.int64)  # bucket l: sources offsets[l]:offsets[l + 1]
-    c32 = c.astype(np.float32)
-    lst, rest = np.empty((N_LIST, cap), np.float64), np.empty((N_LIST, cap), np.float64)
-    own, owner = np.empty(cap, np.int64), np.empty(cap, np.int64)
-    rest_own, rest_owner = np.empty(cap, np.int64), np.empty(cap, np.int64)
-    shared = np.empty((N_SHARED, cap), np.float64)
-    shared_tot = np.zeros(2)
-    geo = np.empty((N_GEO, cap), np.float64)
-    in_dense = np.zeros(cap, np.bool_)
-    order = np.zeros(2 * cap, np.int64)  # bucket of each listed source, then a bucket's members
-    dense = np.empty((N_SRC, padded), np.float32)
-    scratch = np.empty((6, max(tables.shape[1], far_points.shape[1])), c.dtype)
-    scratch32 = np.empty((6, far_points.shape[1]), np.float32)
-    p_ind = np.zeros((n, 2, nb_max), c.dtype)  # per emitter: induced moments of every body
-    body = np.empty((9, nb_max), c.dtype)  # x, y, alpha, m1x, m1y, m2x, m2y, t1x, t1y
-    # sin and cos of every heading and pellet orientation, vectorised (libm's are scalar calls)
-    angles = np.empty(n + pellet_xy.shape[1])
-    sin_t, cos_t = np.empty_like(angles), np.empty_like(angles)
-    share = levels.shape[0] > 0 and flags[CULL] and c[G_SELF] == c[G_CONS]
-    for b in range(b_count):
-        img = image_table(width[b], height[b], img_idx, img_w, c)
-        if flags[DO_AMP]:
+    cap = nb_max * plan.img_idx.shape[0]
+    padded = cap + BLOCK * (plan.levels.shape[0] + 1)  # room for every bucket's padding
+    n_pts = plan.far_points.shape[1]
+    angles = np.empty(n + n_pel)
+    bodies = Bodies(body=np.empty((N_BODY, nb_max), c.dtype), p_ind=np.zeros((n, 2, nb_max), c.dtype),
+                    angles=angles, sin_t=np.empty_like(angles), cos_t=np.empty_like(angles))
+    lists = Lists(lst=np.empty((N_LIST, cap), np.float64), own=np.empty(cap, np.int64),
+                  owner=np.empty(cap, np.int64), rest=np.empty((N_LIST, cap), np.float64),
+                  rest_own=np.empty(cap, np.int64), rest_owner=np.empty(cap, np.int64),
+                  shared=np.empty((N_SHARED, cap), np.float64))
+    staging = Staging(
+        geo=np.empty((N_GEO, cap), np.float64), in_dense=np.zeros(cap, np.bool_), order=np.zeros(2 * cap, np.int64),
+        dense=np.empty((N_SRC, padded), np.float32), exact=np.empty((N_SRC, padded), c.dtype),
+        far=np.empty((N_SRC, padded), np.float32), offsets=np.zeros(plan.levels.shape[0] + 2, np.int64),
+        sensors=np.empty((6, max(plan.sensor_trig.shape[1], n_pts)), c.dtype),
+        points32=np.empty((6, n_pts), np.float32))
+    return Workspace(bodies, lists, staging)
+
+
+@njit(cache=True, error_model="numpy")
+def fill_bodies(b, batch, c, flags, bodies):
+    """Rows B_X, B_Y, B_ALPHA, B_M2X, B_M2Y of ``bodies.body`` for arena ``b``; returns the body count, padded.
+
+    Bodies are the agents (first N), then the arena's live pellets, then inert
+    padding to whole SIMD blocks (no polarisability, no moment, 100 m away), so
+    every loop over bodies runs without a scalar remainder. ``bodies.sin_t`` and
+    ``cos_t`` hold the sines and cosines of the headings and pellet orientations.
+    """
+    body, sin_t, cos_t = bodies.body, bodies.sin_t, bodies.cos_t
+    n, n_pel = batch.agent_xy.shape[1], batch.pellet_xy.shape[1]
+    nb = 0
+    for j in range(n):
+        body[B_X, nb], body[B_Y, nb] = batch.agent_xy[b, j, 0], batch.agent_xy[b, j, 1]
+        body[B_ALPHA, nb] = c[ALPHA_AGENT]
+        body[B_M2X, nb] = c[K] * c[P_AGENT] * cos_t[j] if flags[DO_AMP] else c[ZERO]
+        body[B_M2Y, nb] = c[K] * c[P_AGENT] * sin_t[j] if flags[DO_AMP] else c[ZERO]
+        nb += 1
+    for j in range(n_pel if flags[DO_PELLETS] else 0):
+        if batch.pellet_alive[b, j]:
+            body[B_X, nb], body[B_Y, nb] = batch.pellet_xy[b, j, 0], batch.pellet_xy[b, j, 1]
+            body[B_ALPHA, nb] = c[ALPHA_PELLET]
+            body[B_M2X, nb] = -c[K] * c[P_PELLET] * sin_t[n + j] if flags[DO_AMP] else c[ZERO]
+            body[B_M2Y, nb] = c[K] * c[P_PELLET] * cos_t[n + j] if flags[DO_AMP] else c[ZERO]
+            nb += 1
+    for j in range(nb, -(-nb // BLOCK) * BLOCK):
+        body[B_X, j], body[B_Y, j] = 100.0, 100.0
+        body[B_ALPHA:, j] = c[ZERO]
+    return -(-nb // BLOCK) * BLOCK
+
+
+@njit(cache=True, error_model="numpy")
+def t1_moments(arena, nb, fill, c, bodies):
+    """T1, the sum over emitters of the moments induced in the first ``nb`` bodies, in rows B_T1X, B_T1Y.
+
+    Every agent weighs T1 alike in shared mode; it is filled there only (``fill``,
+    else 0). Returns the largest Mormyromast weight of any agent (0 unless filled).
+    Loops, not array expressions: a kernel that cannot raise keeps no reference counts.
+    """
+    body, p_ind, emitting = bodies.body, bodies.p_ind, arena.emitting
+    n = arena.axy.shape[0]
+    t1x, t1y = body[B_T1X, :nb], body[B_T1Y, :nb]
+    for j in range(nb):
+        t1x[j] = c[ZERO]
+        t1y[j] = c[ZERO]
+    s_max = 0.0
+    if fill:
+        for e in range(n):
+            for j in range(nb):
+                t1x[j] += p_ind[e, 0, j]
+                t1y[j] += p_ind[e, 1, j]
+        for a in range(n):
+            s_max = max(s_max, abs(mormyromast_weights(a, emitting, c)[1]))
+    return s_max
+
+
+@njit(cache=True, error_model="numpy")
+def sense_arenas(batch, plan, ws, out):
+    """Add the raw readings of every arena of ``batch`` to ``out``, with the scratch arrays ``ws``.
+
+    Per arena: bodies, induced moments and T1, the source list (in shared mode,
+    g_self = g_cons, without the far pellet images every agent reads densely),
+    then per agent its Mormyromast moments of the listed sources (``stage.geo``
+    rows G_P1X, G_P1Y, G_A1) and its readings. Fields are read once, before the loops.
+    """
+    c, flags, n, out_m, out_a, out_k = (plan.c, plan.flags, batch.agent_xy.shape[1], out.mormyromast, out.ampullary,
+                                        out.knollenorgan)
+    agent_xy, heading, emits, pellet_phi = batch.agent_xy, batch.heading, batch.emitting, batch.pellet_phi
+    bodies, lists, stage = ws.bodies, ws.lists, ws.staging
+    body, p_ind, angles, sin_t, cos_t = bodies.body, bodies.p_ind, bodies.angles, bodies.sin_t, bodies.cos_t
+    lst, own, owner, shared, geo, dense = lists.lst, lists.own, lists.owner, lists.shared, stage.geo, stage.dense
+    img_idx, img_w, level_lcq, level_e = plan.img_idx, plan.img_w, plan.level_lcq, plan.level_e
+    share = plan.levels.shape[0] > 0 and flags[CULL] and c[G_SELF] == c[G_CONS]
+    sense = flags[DO_MORM] or flags[DO_AMP]
+    for b in range(agent_xy.shape[0]):
+        axy, emitting = agent_xy[b], emits[b]
+        img = image_table(batch.width[b], batch.height[b], img_idx, img_w, c)
+        arena = Arena(axy, heading[b], emitting, img)
+        if flags[DO_AMP]:  # sin and cos of every heading and pellet orientation, vectorised (libm's are scalar calls)
             angles[:n] = heading[b]
             angles[n:] = pellet_phi[b]
             sincos(angles, sin_t, cos_t)
-        nb = 0
-        for j in range(n):
-            body[0, nb], body[1, nb], body[2, nb] = agent_xy[b, j, 0], agent_xy[b, j, 1], c[ALPHA_AGENT]
-            body[5, nb] = c[K] * c[P_AGENT] * cos_t[j] if flags[DO_AMP] else c[ZERO]
-            body[6, nb] = c[K] * c[P_AGENT] * sin_t[j] if flags[DO_AMP] else c[ZERO]
-            nb += 1
-        for j in range(pellet_xy.shape[1] if flags[DO_PELLETS] else 0):
-            if pellet_alive[b, j]:
-                body[0, nb], body[1, nb], body[2, nb] = pellet_xy[b, j, 0], pellet_xy[b, j, 1], c[ALPHA_PELLET]
-                body[5, nb] = -c[K] * c[P_PELLET] * sin_t[n + j] if flags[DO_AMP] else c[ZERO]
-                body[6, nb] = c[K] * c[P_PELLET] * cos_t[n + j] if flags[DO_AMP] else c[ZERO]
-                nb += 1
-        # pad to whole SIMD blocks with inert bodies (no polarisability, no moment, 100 m away):
-        # every loop over bodies then runs without a scalar remainder
-        for j in range(nb, -(-nb // BLOCK) * BLOCK):
-            body[0, j], body[1, j] = 100.0, 100.0
-            body[2:, j] = c[ZERO]
-        nb = -(-nb // BLOCK) * BLOCK
-        n_src = nb * img.shape[0]
+        nb = fill_bodies(b, batch, c, flags, bodies)
         induction = False
-        if flags[DO_INDUCTION]:
-            for e in range(n):
-                induction = induction or emitting[b, e]
-        if induction:
-            induced_dipoles(agent_xy[b], heading[b], emitting[b], body[0, :nb], body[1, :nb], body[2, :nb], img, c,
+        for e in range(n if flags[DO_INDUCTION] else 0):
+            induction = induction or emitting[e]
+        if induction:  # every emitter's EOD and its images polarise every body
+            induced_dipoles(axy, heading[b], emitting, body[B_X, :nb], body[B_Y, :nb], body[B_ALPHA, :nb], img, c,
                             p_ind)
-        # T1: every emitter's induced moment, which each agent weighs alike in shared mode
-        t1x, t1y = body[7, :nb], body[8, :nb]
-        t1x[:] = c[ZERO]
-        t1y[:] = c[ZERO]
-        s_max = 0.0  # the largest Mormyromast weight of any agent
-        if share and flags[DO_MORM] and induction:
-            for e in range(n):
-                t1x += p_ind[e, 0, :nb]
-                t1y += p_ind[e, 1, :nb]
-            for a in range(n):
-                s_max = max(s_max, abs(mormyromast_weights(a, emitting[b], c)[1]))
-        list_images(body[0, :nb], body[1, :nb], body[5, :nb], body[6, :nb], img, n, lst, own, owner)
-        src, src_own, n_list, n_shared = lst, own, n_src, 0
-        shared_tot[:] = 0.0
-        shared_mode = share and (flags[DO_MORM] or flags[DO_AMP])
-        if shared_mode:
-            image_rows(img, t1x, t1y, lst[L_T1X], lst[L_T1Y], lst[L_A1])
-            n_shared, n_list, shared_tot[0], shared_tot[1] = share_far_sources(
-                n_src, agent_xy[b], lst, own, owner, s_max, c[TOL_MORM], c[TOL_AMP], c, level_lcq, level_e, geo,
-                in_dense, order, shared, rest, rest_own, rest_owner)
-            src, src_own = rest, rest_own
-        for a in range(n if (flags[DO_MORM] or flags[DO_AMP]) else 0):
-            weight = mormyromast_weights(a, emitting[b], c)[1] if (flags[DO_MORM] and induction) else 0.0
-            if shared_mode:  # the agent's Mormyromast moments are weight x T1
-                copy_shared(agent_xy[b, a, 0], agent_xy[b, a, 1], weight, shared, n_shared, dense)
-                weighted_moments(a, n_list, weight, rest, rest_owner, geo)
+        s_max = t1_moments(arena, nb, share and flags[DO_MORM] and induction, c, bodies)
+        list_images(body[B_X, :nb], body[B_Y, :nb], body[B_M2X, :nb], body[B_M2Y, :nb], img, n, lst, own, owner)
+        srcs = SourceList(lst, own, owner, nb * img.shape[0], 0, False, 0.0, 0.0)  # every agent stages all sources
+        if share and sense:  # or only those that are not shared
+            image_rows(img, body[B_T1X, :nb], body[B_T1Y, :nb], lst[L_T1X], lst[L_T1Y], lst[L_A1])
+            srcs = share_far_sources(srcs.n, axy, s_max, c, level_lcq, level_e, lists, stage)
+        weighs, srcs_lst, srcs_owner = flags[DO_MORM] and induction, srcs.lst, srcs.owner
+        m1x, m1y = body[B_M1X, :nb], body[B_M1Y, :nb]
+        for a in range(n if sense else 0):
+            weight = mormyromast_weights(a, emitting, c)[1] if weighs else 0.0
+            if srcs.shared:  # the agent's Mormyromast moments are weight x T1
+                copy_shared(axy[a, 0], axy[a, 1], weight, shared, srcs.n_shared, dense)
+                weighted_moments(a, srcs.n, weight, srcs_lst, srcs_owner, geo)
             else:  # the full list, with the agent's own moments of every body
-                if flags[DO_MORM] and induction:
-                    mormyromast_moments(a, emitting[b], p_ind, c, body[3, :nb], body[4, :nb])
+                if weighs:
+                    mormyromast_moments(a, emitting, p_ind, c, m1x, m1y)
                 else:
-                    body[3, :nb] = c[ZERO]
-                    body[4, :nb] = c[ZERO]
-                imaged_moments(img, body[3, :nb], body[4, :nb], geo)
-            sense_agent(a, agent_xy[b], heading[b], emitting[b], n_list, src, src_own, n_shared, shared_tot, img, c,
-                        c32, flags, tables, levels, level_lcq, level_e, far_offsets, far_points, interp_m, interp_a,
-                        geo, in_dense, order, dense, exact, far, offsets, scratch, scratch32,
-                        out_m[b, a], out_a[b, a])
+                    m1x[:] = c[ZERO]
+                    m1y[:] = c[ZERO]
+                imaged_moments(img, m1x, m1y, geo)
+            sense_agent(a, arena, srcs, plan, stage, out_m[b, a], out_a[b, a])
         if flags[DO_KNOLL]:
-            knollenorgan_env(agent_xy[b], heading[b], emitting[b], cos_k, sin_k, c, flags, out_k[b])
+            knollenorgan_env(arena, plan, out_k[b])
+
+
+@njit(cache=True, error_model="numpy")
+def sense_batch_kernel(batch_fields, plan_fields, out_fields):
+    """Add the raw readings of B arenas to the outputs; positions in m, in the dtype of ``PlanTables.c``.
+
+    The arguments are the fields of a :class:`~efish.physics.kernel_inputs.BatchArrays`,
+    a :class:`~efish.physics.kernel_inputs.PlanTables` and an
+    :class:`~efish.physics.kernel_inputs.Outputs` (zeroed by the caller) as plain
+    tuples, ``tuple(named)``: numba types a plain tuple of arrays in C, a named one
+    in Python (about 4 us per call). They are named again here, in the fields' own order.
+    :func:`efish.physics.fast.fast_raw` builds them and calls this.
+    """
+    batch, plan, out = BatchArrays(*batch_fields), PlanTables(*plan_fields), Outputs(*out_fields)
+    sense_arenas(batch, plan, make_workspace(batch, plan), out)

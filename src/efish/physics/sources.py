@@ -26,7 +26,8 @@ import math
 import numpy as np
 
 from .._jit import njit
-from .kernels import _FASTMATH, FAR_MAX_LS, FAR_MAX_LX, M1X, M1Y, M2X, M2Y, R_SENS, SX, SY
+from .kernel_inputs import SourceList
+from .kernels import _FASTMATH, FAR_MAX_LS, FAR_MAX_LX, M1X, M1Y, M2X, M2Y, R_SENS, SX, SY, TOL_AMP, TOL_MORM
 
 # Rows of a source list (float64), one column per body image; in the arena's full list
 # image i of body j is column i * bodies + j. Moments are image moments (mirrored,
@@ -235,23 +236,26 @@ def copy_columns(src, rows, index, count, dst, first):
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def share_far_sources(n, axy, lst, own, owner, s_max, thr1, thr2, c, level_lcq, level_e, geo, flag, order,
-                      shared, rest, rest_own, rest_owner):
-    """Split the first ``n`` listed sources into those every agent serves by the first far level and the rest.
+def share_far_sources(n, axy, s_max, c, level_lcq, level_e, lists, stage):
+    """Split the first ``n`` sources of ``lists.lst`` into those every agent serves by the first far level and the rest.
 
-    The test runs once per arena at the distance of the nearest agent, with
-    the Mormyromast moment T1 times the largest agent weight ``s_max``, so a
-    shared source passes the per-agent test of every agent. Agents' bodies are
-    never shared (each agent drops its own). Shared sources go to ``shared``
-    (rows ``S_*``), the rest to ``rest`` (rows ``L_*``, with ``rest_own`` and
-    ``rest_owner``). Returns both counts and the bound sums of the shared
-    sources in both columns (for the exact-zero test of each agent).
+    ``axy``: DT[N, 2], the arena's agents; ``level_lcq``, ``level_e``: float64[L]
+    (see :func:`dense_level_sources`); ``lists``, ``stage``: see
+    :mod:`efish.physics.kernel_inputs`. The test runs once per arena at the
+    distance of the nearest agent, with the Mormyromast moment T1 times the largest
+    agent weight ``s_max``, so a shared source passes the per-agent test of every
+    agent. Agents' bodies are never shared (each agent drops its own). Shared
+    sources go to ``lists.shared`` (rows ``S_*``), the rest to ``lists.rest`` (rows
+    ``L_*``, with ``lists.rest_own`` and ``lists.rest_owner``). Returns the rest as
+    the :class:`~efish.physics.kernel_inputs.SourceList` each agent stages, with the
+    bound sums of the shared sources in both columns (for each agent's exact-zero test).
     """
-    own, owner = own[:n], owner[:n]
+    lst, geo, flag, order = lists.lst, stage.geo, stage.in_dense, stage.order
+    own, owner = lists.own[:n], lists.owner[:n]
     d2 = geo[G_D2, :n]
     nearest_distance2(axy, lst[L_X, :n], lst[L_Y, :n], d2)
-    inv1 = s_max / thr1
-    source_bounds(-2, d2, own, lst[L_A1, :n], lst[L_A2, :n], inv1, 1.0 / thr2, c[R_SENS], geo)
+    inv1 = s_max / c[TOL_MORM]
+    source_bounds(-2, d2, own, lst[L_A1, :n], lst[L_A2, :n], inv1, 1.0 / c[TOL_AMP], c[R_SENS], geo)
     dense_level_sources(n, geo, level_lcq, level_e, c, flag)
     n_shared = 0
     total1 = total2 = 0.0
@@ -267,11 +271,12 @@ def share_far_sources(n, axy, lst, own, owner, s_max, thr1, thr2, c, level_lcq, 
     for k in range(n):
         rest_index[n_rest] = k
         n_rest += (flag[k] == 0) | (owner[k] != NOBODY)
-    copy_columns(lst, (L_X, L_Y, L_T1X, L_T1Y, L_M2X, L_M2Y), order, n_shared, shared, 0)
-    copy_columns(lst, (L_X, L_Y, L_T1X, L_T1Y, L_M2X, L_M2Y, L_A1, L_A2), rest_index, n_rest, rest, 0)
+    copy_columns(lst, (L_X, L_Y, L_T1X, L_T1Y, L_M2X, L_M2Y), order, n_shared, lists.shared, 0)
+    copy_columns(lst, (L_X, L_Y, L_T1X, L_T1Y, L_M2X, L_M2Y, L_A1, L_A2), rest_index, n_rest, lists.rest, 0)
+    rest_own, rest_owner = lists.rest_own, lists.rest_owner
     for t in range(n_rest):
         rest_own[t], rest_owner[t] = own[rest_index[t]], owner[rest_index[t]]
-    return n_shared, n_rest, total1 * s_max, total2
+    return SourceList(lists.rest, rest_own, rest_owner, n_rest, n_shared, True, total1 * s_max, total2)
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
@@ -309,30 +314,39 @@ def imaged_moments(img, m1x, m1y, geo):
     image_rows(img, m1x, m1y, geo[G_P1X], geo[G_P1Y], geo[G_A1])
 
 
-@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def gather_sources(a, n, ax, ay, lst, own, thr1, thr2, c, level_lcq, level_e, n_shared, geo, in_dense, order, dense,
-                   exact, far, offsets):
-    """The first ``n`` listed sources whose bound at agent ``a`` reaches a threshold, bucketed by level.
+@njit(cache=True, error_model="numpy")
+def bucket_offsets(bucket, offsets):
+    """offsets (int64[L + 2]): bucket l of ``bucket`` (int64[n], -1: none) gets columns offsets[l]:offsets[l + 1].
 
-    ``geo`` rows G_P1X, G_P1Y, G_A1 hold the agent's Mormyromast moments of
-    the listed sources (:func:`weighted_moments` or :func:`imaged_moments`);
-    ``dense[:, :n_shared]`` already holds the shared sources. Column 1
-    (Mormyromast) and column 2 (Ampullary) are culled separately; a culled
-    column is stored as 0. Listed sources of the first far level go to
-    ``dense`` after the shared ones (float32, positions relative to the agent,
-    where float32 is precise), every source in its own column with the others'
-    moments zeroed: one long loop over sources evaluates them. Only the rest, a
-    few tens, are bucketed: bucket l holds sources ``offsets[l]:offsets[l + 1]``,
-    the exact ones (bucket 0) in ``exact`` in the working dtype, those of the
-    higher levels in the same columns of ``far`` in float32 (bucket 1, the
-    dense level, stays empty). Every bucket is padded with inert sources
-    (moment 0, 1 m away) to a multiple of ``EXACT_BLOCK`` (bucket 0) or
-    ``BLOCK``, so its loops run without a scalar remainder. Returns the number
-    of dense columns (0 without far levels) and the bound sums of both columns.
+    Each bucket is padded to a multiple of ``EXACT_BLOCK`` (bucket 0) or ``BLOCK``.
     """
-    own = own[:n]
-    x, y = lst[L_X, :n], lst[L_Y, :n]
-    d2 = geo[G_D2, :n]
+    offsets[:] = 0
+    for k in range(bucket.shape[0]):
+        offsets[bucket[k] + 1] += bucket[k] >= 0
+    for lv in range(offsets.shape[0] - 1):
+        block = EXACT_BLOCK if lv == 0 else BLOCK
+        offsets[lv + 1] = offsets[lv] + -(-offsets[lv + 1] // block) * block
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def gather_sources(a, ax, ay, thr1, thr2, srcs, c, level_lcq, level_e, stage):
+    """Stage the listed sources of ``srcs`` whose bound at agent ``a`` (at (ax, ay)) reaches a threshold, by level.
+
+    ``stage.geo`` rows G_P1X, G_P1Y, G_A1 hold the agent's Mormyromast moments
+    (:func:`weighted_moments` or :func:`imaged_moments`), ``stage.dense[:, :srcs.n_shared]``
+    the shared sources. Column 1 (Mormyromast) and 2 (Ampullary) are culled against
+    ``thr1``, ``thr2`` separately; a culled column is stored as 0. Sources of the first
+    far level (``level_lcq``, ``level_e``: float64[L]) go to ``stage.dense`` after the
+    shared ones (float32, relative to the agent), each in its own column with the
+    others' moments zeroed: one long loop evaluates them. The rest, a few tens, are
+    bucketed (:func:`bucket_offsets`): exact ones (bucket 0) to ``stage.exact`` in the
+    working dtype, higher levels to the same columns of ``stage.far`` in float32
+    (bucket 1, the dense level, stays empty); every bucket is padded with inert sources
+    (moment 0, 1 m away), so its loops have no scalar remainder. Returns the number of
+    dense columns (0 without far levels) and the bound sums of both columns.
+    """
+    n, n_shared, lst, geo, in_dense, dense = srcs.n, srcs.n_shared, srcs.lst, stage.geo, stage.in_dense, stage.dense
+    own, x, y, d2 = srcs.own[:n], lst[L_X, :n], lst[L_Y, :n], geo[G_D2, :n]
     distance2(ax, ay, x, y, d2)
     inv1 = 1.0 / thr1 if thr1 > 0 else 0.0
     inv2 = 1.0 / thr2 if thr2 > 0 else 0.0
@@ -357,23 +371,16 @@ def gather_sources(a, n, ax, ay, lst, own, thr1, thr2, c, level_lcq, level_e, n_
         ox[k], oy[k] = x[k] - ax, y[k] - ay
     masked_copy(geo[G_M1X, :n], geo[G_M1Y, :n], in_dense[:n], dense[M1X, n_shared:m], dense[M1Y, n_shared:m])
     masked_copy(geo[G_M2X, :n], geo[G_M2Y, :n], in_dense[:n], dense[M2X, n_shared:m], dense[M2Y, n_shared:m])
-    for k in range(m, n_dense):
-        dense[SX, k], dense[SY, k] = 1.0, 0.0
-        dense[M1X, k] = dense[M1Y, k] = dense[M2X, k] = dense[M2Y, k] = 0.0
-    # the others, a few tens, by bucket; each bucket padded to whole blocks
-    bucket, members = order[:n], order[n:2 * n]
+    pad_bucket(dense, m, n_dense, 0.0)
+    # the others, a few tens, by bucket
+    bucket, members, offsets, exact, far = stage.order[:n], stage.order[n:2 * n], stage.offsets, stage.exact, stage.far
     if n_levels > 0:
         source_buckets(n, geo, in_dense, level_lcq, level_e, c, bucket)
     else:
         for k in range(n):
             bucket[k] = 0 if geo[G_KEEP, k] != 0 else -1
-    offsets[:] = 0
-    for k in range(n):
-        offsets[bucket[k] + 1] += bucket[k] >= 0
-    for lv in range(offsets.shape[0] - 1):
-        block = EXACT_BLOCK if lv == 0 else BLOCK
-        offsets[lv + 1] = offsets[lv] + -(-offsets[lv + 1] // block) * block
-    end = fill_bucket(bucket, 0, x, y, geo, 0.0, 0.0, members, exact, 0)  # exact: absolute positions, working dtype
+    bucket_offsets(bucket, offsets)
+    end = fill_bucket(bucket, 0, x, y, geo, 0.0, 0.0, members, exact, 0)  # exact: absolute positions
     pad_bucket(exact, end, offsets[1], ax)
     for lv in range(2, offsets.shape[0] - 1):  # bucket 1, the dense level, stays empty
         if offsets[lv + 1] > offsets[lv]:
