@@ -160,10 +160,13 @@ def own_eod_images(out, xy, heading, img, c, sx, sy, nx, ny):
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def knollenorgan_env(arena, plan, out):
-    """out[a, slot] (DT[N, N - 1, S_k]) = direct EOD field of the slot's conspecific at a's sensors, no images."""
-    axy, heading, emitting, c, cull, cos_k, sin_k = (arena.axy, arena.heading, arena.emitting, plan.c,
-                                                      plan.flags[CULL], plan.cos_k, plan.sin_k)
+def knollenorgan_env(arena, c, cull, cos_k, sin_k, out):
+    """out[a, slot] (DT[N, N - 1, S_k]) = direct EOD field of the slot's conspecific at a's sensors, no images.
+
+    ``cos_k``, ``sin_k`` (DT[S_k]): the sensor angles; ``cull``: skip pairs whose
+    every spike would be 0 after binarisation.
+    """
+    axy, heading, emitting = arena.axy, arena.heading, arena.emitting
     n, s_count = axy.shape[0], cos_k.shape[0]
     sx, sy = np.empty(s_count, c.dtype), np.empty(s_count, c.dtype)
     nx, ny = np.empty(s_count, c.dtype), np.empty(s_count, c.dtype)
@@ -375,7 +378,8 @@ def sense_arenas(batch, plan, ws, out):
     bodies, lists, stage = ws.bodies, ws.lists, ws.staging
     body, p_ind, angles, sin_t, cos_t = bodies.body, bodies.p_ind, bodies.angles, bodies.sin_t, bodies.cos_t
     lst, own, owner, shared, geo, dense = lists.lst, lists.own, lists.owner, lists.shared, stage.geo, stage.dense
-    img_idx, img_w, level_lcq, level_e = plan.img_idx, plan.img_w, plan.level_lcq, plan.level_e
+    img_idx, img_w, level_lcq, level_e, cos_k, sin_k = (plan.img_idx, plan.img_w, plan.level_lcq, plan.level_e,
+                                                       plan.cos_k, plan.sin_k)
     share = plan.levels.shape[0] > 0 and flags[CULL] and c[G_SELF] == c[G_CONS]
     sense = flags[DO_MORM] or flags[DO_AMP]
     for b in range(agent_xy.shape[0]):
@@ -415,7 +419,7 @@ def sense_arenas(batch, plan, ws, out):
                 imaged_moments(img, m1x, m1y, geo)
             sense_agent(a, arena, srcs, plan, stage, out_m[b, a], out_a[b, a])
         if flags[DO_KNOLL]:
-            knollenorgan_env(arena, plan, out_k[b])
+            knollenorgan_env(arena, c, flags[CULL], cos_k, sin_k, out_k[b])
 
 
 @njit(cache=True, error_model="numpy")
