@@ -18,7 +18,7 @@ def condition_configs(overrides: Sequence[str]) -> dict[str, EfishConfig]:
     """Each condition's config: the assay's, with the condition's overrides on top and the scale's caps on
     episode length applied. A condition whose overrides do not compose is one clear error naming it."""
     name = next((o.split("=", 1)[1] for o in reversed(overrides) if o.startswith("assay=")), "")
-    configs = compose_variants(overrides, label=f"assay {name}, condition".replace("assay ,", "assay,"))
+    configs = compose_variants(overrides, label=f"assay {name}, condition" if name else "condition")
     return {name: dataclasses.replace(cfg, env=dataclasses.replace(
         cfg.env, episode_steps=min(cfg.env.episode_steps, cfg.scale.max_episode_steps))) for name, cfg in configs.items()}
 
