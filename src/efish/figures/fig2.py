@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import pandas as pd
 
+from .panel import Panel
 from .style import agent_colour, missing
 
 CONDITION_STYLE = {"electric": "-", "raycast": "--"}
@@ -32,3 +33,9 @@ def trajectories(tables: dict[str, pd.DataFrame], ax) -> None:
     ax.set_xlabel("x (cm)")
     ax.set_ylabel("y (cm)")
     ax.set_title("Homing trajectories")
+
+
+PANELS = [
+    Panel("fig2", "B", trajectories, {"steps": "assays/homing/steps.parquet"},
+          "Homing trajectories of the homing policy towards a frozen, always-emitting target (SPEC 11)."),
+]

@@ -6,6 +6,7 @@ import numpy as np
 import pandas as pd
 
 from ..analysis.selection import ols_fit
+from .panel import Panel
 from .style import NEUTRAL_COLOUR, SELECTED_COLOUR, missing
 
 
@@ -26,3 +27,9 @@ def food_vs_size(tables: dict[str, pd.DataFrame], ax) -> None:
     ax.set_xlabel("body size")
     ax.set_ylabel("food eaten per episode")
     ax.set_title(f"Food vs size ({episodes['episode'].nunique()} episodes)")
+
+
+PANELS = [
+    Panel("fig3", "M", food_vs_size, {"episodes": "assays/patchy4/episodes.parquet"},
+          "Food eaten per agent-episode against body size, selected seed, 4-agent patchy 70x70 arena."),
+]

@@ -11,7 +11,8 @@ from ..io import atomic_path, read_parquet
 from .registry import PANELS, Panel
 from .style import panel_style
 
-PANEL_SIZE_IN = (3.2, 2.6)
+#: One journal column wide (3.5 in), so fonts of 7-8 pt are legible at print size.
+PANEL_SIZE_IN = (3.5, 2.8)
 
 
 def input_paths(panel: Panel, results: Path, seeds: int) -> dict[str, list[Path]]:
@@ -39,7 +40,8 @@ def render_panel(key: str, results: Path, out: Path, seeds: int) -> list[Path]:
     panel = _panel(key)
     tables = load_tables(panel, results, seeds)
     with panel_style() as plt:
-        fig, ax = plt.subplots(figsize=PANEL_SIZE_IN, constrained_layout=True)
+        fig = plt.figure(figsize=PANEL_SIZE_IN, layout="constrained")
+        ax = fig.add_subplot(projection=panel.projection)
         panel.draw(tables, ax)
         written = save_figure(fig, out / panel.figure / panel.name)
         plt.close(fig)
@@ -53,14 +55,12 @@ def render_page(figure: str, panels: list[Panel], results: Path, out: Path, seed
     cols = min(3, len(panels))
     rows = math.ceil(len(panels) / cols)
     with panel_style() as plt:
-        fig, axes = plt.subplots(rows, cols, figsize=(PANEL_SIZE_IN[0] * cols, PANEL_SIZE_IN[1] * rows),
-                                 constrained_layout=True, squeeze=False)
-        for ax, panel in zip(axes.flat, panels):
+        fig = plt.figure(figsize=(PANEL_SIZE_IN[0] * cols, PANEL_SIZE_IN[1] * rows), layout="constrained")
+        for i, panel in enumerate(panels, 1):
+            ax = fig.add_subplot(rows, cols, i, projection=panel.projection)
             panel.draw(load_tables(panel, results, seeds), ax)
             ax.text(-0.15, 1.05, panel.name if len(panel.name) == 1 else "", transform=ax.transAxes,
                     fontweight="bold", fontsize=11)
-        for ax in list(axes.flat)[len(panels):]:
-            ax.set_visible(False)
         written = save_figure(fig, out / figure)
         plt.close(fig)
     return written

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from .panel import Panel
 from .style import NEUTRAL_COLOUR, SELECTED_COLOUR, missing
 
 
@@ -52,3 +53,11 @@ def _selected_seed(tables: dict[str, pd.DataFrame]) -> int | None:
     return int(ranking.loc[ranking["selected"], "seed"].iloc[0])
 
 
+PANELS = [
+    Panel("supp", "training_curves", training_curves,
+          {"metrics": "train/seed_{seed}/metrics.parquet", "ranking": "analysis/selection/ranking.parquet"},
+          "Mean episode return during training, every seed; the selected seed in colour."),
+    Panel("supp", "seed_landscape", seed_landscape, {"ranking": "analysis/selection/ranking.parquet"},
+          "Seed selection (SPEC 10): food per episode against the size-food slope; marker area is R^2, "
+          "hollow markers are seeds dropped for a non-positive intercept, the ring marks the selected seed."),
+]
