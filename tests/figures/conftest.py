@@ -12,7 +12,7 @@ import pandas as pd
 import pytest
 
 from efish.analysis.registry import analyses_for, run, tables_written
-from efish.analysis.selection import rank_seeds, seed_statistics
+from efish.analysis.selection import rank_seeds, seed_statistics, stack_top_seeds
 from efish.config import compose
 from tests.helpers import rollout_tables
 
@@ -55,6 +55,12 @@ def synthetic_results(tmp_path_factory) -> Path:
             "entropy": 2 - steps / 10000})}, root / "train" / f"seed_{seed}")
         sel, _ = _assay_tables("selection", seed)
         episodes.append(sel["episodes"].assign(seed=seed))
-    _write({"ranking": rank_seeds(seed_statistics(pd.concat(episodes, ignore_index=True)))},
-           root / "analysis" / "selection")
+    ranking = rank_seeds(seed_statistics(pd.concat(episodes, ignore_index=True)))
+    _write({"ranking": ranking}, root / "analysis" / "selection")
+    for assay in base.scale.top_seed_assays:
+        paths = []
+        for seed in range(1, SEEDS + 1):
+            _write({"episodes": _assay_tables(assay, seed)[0]["episodes"]}, root / f"seeds/seed_{seed}/assays/{assay}")
+            paths.append(root / f"seeds/seed_{seed}/assays/{assay}/episodes.parquet")
+        _write({"episodes": stack_top_seeds(paths, ranking)}, root / "seeds" / assay)
     return root

@@ -63,12 +63,13 @@ rule top_seed_assay:
 
 rule top_seeds:
     input:
-        top_seed_targets,
+        tables=top_seed_tables,
+        ranking="results/{run}/analysis/selection/ranking.parquet",
     output:
-        "results/{run}/seeds/done.txt",
+        "results/{run}/seeds/{assay}/episodes.parquet",
     log:
-        "results/{run}/logs/seeds/done.log",
+        "results/{run}/logs/seeds/{assay}.log",
     conda:
         "../envs/efish.yaml"
     shell:
-        "printf '%s\\n' {input} > {output} 2> {log}"
+        "efish stack-seeds {input.tables} --ranking {input.ranking} --out {output} > {log} 2>&1"

@@ -13,7 +13,7 @@ from efish._numba_cache import source_digest
 from efish.config import ConfigError, compose, config_dir, run_name
 from efish.env.observe import observation_size
 from efish.rollout.assay import check_observation_sizes, condition_configs, policies_needed
-from efish.figures.registry import PANELS, panels_for
+from efish.figures.registry import PANELS, drawable
 from efish.figures.render import input_paths
 
 CONFIG_KEYS = ("scale", "overrides", "run")
@@ -98,7 +98,7 @@ ASSAY_POLICIES = checked_assays()
 HIDDEN_ASSAYS = [name for name in ASSAYS if assay_config(name).assay.record_hidden]
 # The analyses of each assay of the scale whose tables it writes (dynamics waits for assay.record_hidden).
 ASSAY_ANALYSES = {name: analyses_for(name, tables_written(assay_config(name).assay)) for name in ASSAYS}
-DRAWABLE = panels_for(ASSAYS)
+DRAWABLE = drawable(CFG.scale)
 
 
 wildcard_constraints:
@@ -154,11 +154,10 @@ def top_seeds(wildcards):
     return [int(s) for s in ranking["seed"].head(CFG.scale.top_seeds)]
 
 
-def top_seed_targets(wildcards):
-    """Tables of the top seeds' assays (supplement): results/{run}/seeds/seed_{n}/assays/{assay}/."""
-    return [f"results/{wildcards.run}/seeds/seed_{seed}/assays/{assay}/{table}.parquet"
-            for seed in top_seeds(wildcards) for assay in CFG.scale.top_seed_assays
-            for table in ("steps", "episodes", "food")]
+def top_seed_tables(wildcards):
+    """The episodes tables of the top seeds in assay {assay} (supplement): results/{run}/seeds/seed_{n}/assays/."""
+    return [f"results/{wildcards.run}/seeds/seed_{seed}/assays/{wildcards.assay}/episodes.parquet"
+            for seed in top_seeds(wildcards)]
 
 
 def panel_of(wildcards):
@@ -180,7 +179,7 @@ def all_targets():
     targets += [f"results/{RUN}/assays/{a}/{t}.parquet" for a in ASSAYS for t in ("steps", "episodes", "food")]
     targets += [f"results/{RUN}/assays/{a}/hidden.parquet" for a in HIDDEN_ASSAYS]
     if CFG.scale.top_seeds:
-        targets.append(f"results/{RUN}/seeds/done.txt")
+        targets += [f"results/{RUN}/seeds/{assay}/episodes.parquet" for assay in CFG.scale.top_seed_assays]
     targets += [path for a, analyses in ASSAY_ANALYSES.items() for an in analyses
                 for path in analysis_outputs(an, RUN, a).values()]
     targets += [f"figures/{RUN}/{p.figure}/{p.name}.{ext}" for p in DRAWABLE for ext in ("png", "pdf")]

@@ -93,3 +93,16 @@ def select_seed(paths: Iterable[str | Path]) -> tuple[pd.DataFrame, int]:
     """SPEC 10 on the episodes tables at ``paths``: the full ranking table and the chosen seed."""
     table = rank_seeds(seed_statistics(read_seed_episodes(paths)))
     return table, int(table.loc[table["selected"], "seed"].iloc[0])
+
+
+def stack_top_seeds(paths: Iterable[str | Path], ranking: pd.DataFrame) -> pd.DataFrame:
+    """The tables at ``paths`` (each under a ``seed_<n>`` folder) as one frame with ``seed`` and ``rank``
+    columns, ``rank`` 1 for the best-ranked seed of ``ranking``: the supplement's top-seed panels read it.
+
+    A seed absent from the ranking is one clear ``ValueError``.
+    """
+    table = read_seed_episodes(paths)
+    rank = {int(seed): i for i, seed in enumerate(ranking["seed"], 1)}
+    if unknown := sorted(set(table["seed"]) - set(rank)):
+        raise ValueError(f"seeds {unknown} are not in the ranking table")
+    return table.assign(rank=table["seed"].map(rank)).sort_values(["rank", "episode", "agent"], ignore_index=True)

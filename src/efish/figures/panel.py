@@ -44,3 +44,7 @@ class Panel:
             elif parts[0] == "analysis" and len(parts) > 3:  # analysis/<analysis>/<assay>/<table>.parquet
                 names.add(parts[2])
         return names
+
+    def top_seed_assays(self) -> set[str]:
+        """Assays of the top-ranked seeds whose stacked tables this panel reads (``seeds/<assay>/...``)."""
+        return {path.split("/")[1] for path in self.inputs.values() if path.startswith("seeds/")}

@@ -14,7 +14,7 @@ from .panel import Panel
 PANELS: dict[str, Panel] = {p.key: p for module in (fig1, fig2, fig3, fig4, fig5, fig6, supplement)
                             for p in module.PANELS}
 
-__all__ = ["PANELS", "Panel", "figures", "panels_for"]
+__all__ = ["PANELS", "Panel", "drawable", "figures", "panels_for"]
 
 
 def figures() -> dict[str, list[Panel]]:
@@ -25,6 +25,12 @@ def figures() -> dict[str, list[Panel]]:
     return grouped
 
 
-def panels_for(assays: list[str]) -> list[Panel]:
-    """The panels whose assays are all among ``assays`` (what a scale can draw)."""
-    return [p for p in PANELS.values() if p.assays() <= set(assays)]
+def panels_for(assays: list[str], top_seed_assays: list[str] = ()) -> list[Panel]:
+    """The panels a scale can draw: those whose assays are all among ``assays`` and whose top-seed tables
+    are all among ``top_seed_assays`` (empty when the scale runs no top seeds)."""
+    return [p for p in PANELS.values() if p.assays() <= set(assays) and p.top_seed_assays() <= set(top_seed_assays)]
+
+
+def drawable(scale) -> list[Panel]:
+    """The panels a scale (``cfg.scale``) draws: its assays, and its top seeds' assays when it runs top seeds."""
+    return panels_for(scale.assays, scale.top_seed_assays if scale.top_seeds else ())

@@ -40,12 +40,17 @@ def render_panel(key: str, results: Path, out: Path, seeds: int) -> list[Path]:
     panel = _panel(key)
     tables = load_tables(panel, results, seeds)
     with panel_style() as plt:
-        fig = plt.figure(figsize=PANEL_SIZE_IN, layout="constrained")
-        ax = fig.add_subplot(projection=panel.projection)
-        panel.draw(tables, ax)
+        fig = draw_panel(panel, tables, plt)
         written = save_figure(fig, out / panel.figure / panel.name)
         plt.close(fig)
     return written
+
+
+def draw_panel(panel: Panel, tables: dict[str, pd.DataFrame], plt):
+    """A new one-column figure with ``panel`` drawn from ``tables`` (inside :func:`panel_style`)."""
+    fig = plt.figure(figsize=PANEL_SIZE_IN, layout="constrained")
+    panel.draw(tables, fig.add_subplot(projection=panel.projection))
+    return fig
 
 
 def render_page(figure: str, panels: list[Panel], results: Path, out: Path, seeds: int) -> list[Path]:
