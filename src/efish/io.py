@@ -19,6 +19,16 @@ _PARTIAL = re.compile(r"^\..+\.[a-z0-9_]{8}(\.[A-Za-z0-9]+)?$")  # tempfile.mkst
 PROVENANCE_PACKAGES = ("numpy", "numba", "pandas", "pyarrow", "hydra-core", "omegaconf", "matplotlib", "torch")
 
 
+def _file_mode() -> int:
+    """0666 minus the process umask: the mode ``open(path, "w")`` gives a new file."""
+    umask = os.umask(0)
+    os.umask(umask)
+    return 0o666 & ~umask
+
+
+_FILE_MODE = _file_mode()
+
+
 @contextmanager
 def atomic_path(path: str | os.PathLike, commit: bool = True) -> Iterator[Path]:
     """Yield a temporary path beside ``path``; rename it into place only if the block succeeds.
@@ -31,6 +41,7 @@ def atomic_path(path: str | os.PathLike, commit: bool = True) -> Iterator[Path]:
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
     os.close(fd)
     tmp_path = Path(tmp)
+    tmp_path.chmod(_FILE_MODE)  # mkstemp makes 0600; outputs get the mode a plain open() would give them
     try:
         yield tmp_path
         if commit:

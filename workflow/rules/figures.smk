@@ -18,6 +18,7 @@ rule panel:
     params:
         overrides=ARGS,
         caption=lambda w: panel_of(w).caption,
+        tables=lambda w: ", ".join(f"``{path}``" for path in panel_of(w).inputs.values()) or "none (a schematic)",
         out=folder_of("png", up=1),
     wildcard_constraints:
         figure="fig[0-9]+|supp",
@@ -32,7 +33,7 @@ rule figure_page:
     input:
         lambda w: [path for p in DRAWABLE if p.figure == w.figure for path in panel_inputs(p)],
     output:
-        png="figures/{run}/{figure}.png",
+        png=report("figures/{run}/{figure}.png", caption="../report/figure_page.rst", category="Figure pages"),
         pdf="figures/{run}/{figure}.pdf",
     log:
         "results/{run}/logs/figures/{figure}.log",
@@ -41,6 +42,7 @@ rule figure_page:
     params:
         overrides=ARGS,
         out=folder_of("png"),
+        panels=lambda w: ", ".join(p.name for p in DRAWABLE if p.figure == w.figure),
     wildcard_constraints:
         figure="fig[0-9]+|supp",
     conda:
