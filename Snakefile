@@ -15,7 +15,9 @@ include: "workflow/rules/train.smk"
 include: "workflow/rules/select.smk"
 include: "workflow/rules/assays.smk"
 include: "workflow/rules/analysis.smk"
+include: "workflow/rules/scenes.smk"
 include: "workflow/rules/figures.smk"
+include: "workflow/rules/render.smk"
 
 
 rule all:

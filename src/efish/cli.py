@@ -6,10 +6,18 @@
     efish assay [overrides] --policy P...     run an assay into steps/episodes/food(/hidden).parquet
     efish schema steps|episodes|food|hidden   the columns of a rollout table and what they mean
     efish select --episodes F... --out D      rank seeds, write the ranking and the chosen seed
+    efish stack-seeds TABLE... --ranking R --out F   the top seeds' tables as one, with seed and rank columns
     efish analyze NAME [overrides] --tables D --out D   one analysis of an assay's tables -> <table>.parquet
     efish figure FIG[/PANEL] [overrides]      draw a panel (or a figure's page) from the result tables
+    efish render assay=NAME [overrides] [--condition C] [--episode K] [--out F.gif|F.mp4] [--field]
+                                              one episode of an assay as a clip, from its rollout tables
+    efish contact-sheet [overrides] [--figures D] [--out F.png]   every panel's PNG as a thumbnail with its id
+    efish claims [overrides] [--results D] [--out D]   the paper's claims as verdicts -> claims.parquet, claims.md
+    efish compare-claims A B                  two runs' claim verdicts and effects side by side
+    efish scene NAME [overrides] --out D      field maps of config/scene/NAME.yaml -> D/NAME.parquet
     efish bench physics [overrides] [--json]  sensing throughput, fast vs reference
     efish bench accuracy [overrides] --out D  accuracy-vs-time study -> table + figure
+    efish bench scaling [overrides] --out D   cost per agent-step vs pellets and agents -> table + figure
     efish bench env [overrides] [--json]      env-only throughput, fast vs reference physics
     efish bench train [overrides] [--json]    rollout/update speed, model-FLOP utilisation
     efish bench pipeline [--results D]        time per rule family of a pipeline run (Snakemake benchmarks)
@@ -22,6 +30,7 @@ and nothing is written.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import logging
 import sys
@@ -58,16 +67,48 @@ def _parser() -> argparse.ArgumentParser:
     sel.add_argument("--episodes", nargs="+", type=Path, required=True,
                      help="episodes.parquet files in folders named seed_<n>")
     sel.add_argument("--out", type=Path, required=True, help="folder for ranking.parquet and selected_seed.txt")
+    st = sub.add_parser("stack-seeds", help="stack the top seeds' tables (each under seed_<n>/) into one table")
+    st.add_argument("tables", nargs="+", type=Path)
+    st.add_argument("--ranking", type=Path, required=True, help="the seed ranking (analysis/selection/ranking.parquet)")
+    st.add_argument("--out", type=Path, required=True, help="the stacked table (.parquet)")
+    st.add_argument("overrides", nargs="*", default=[])
     an = sub.add_parser("analyze", help="run one analysis (efish.analysis.registry) on an assay's rollout tables")
     an.add_argument("name", help="an analysis of efish.analysis.registry, e.g. behaviour (a wrong name lists them)")
     an.add_argument("overrides", nargs="*", help="config overrides, e.g. assay=patchy4 analysis.rate_bins=10")
     an.add_argument("--tables", type=Path, required=True, help="folder of the assay's tables (steps.parquet, ...)")
     an.add_argument("--out", type=Path, required=True, help="folder for <table>.parquet, config.yaml, provenance.json")
+    sc = sub.add_parser("scene", help="compute a scene's field maps (config/scene/<name>.yaml) into a table")
+    sc.add_argument("name", help="a scene of config/scene/, e.g. eod_walls")
+    sc.add_argument("overrides", nargs="*", help="config overrides, e.g. scene.resolution_cm=1")
+    sc.add_argument("--out", type=Path, help="folder for <name>.parquet (default results/{scale}/scenes)")
     fg = sub.add_parser("figure", help="draw a panel (fig3/M) or a whole figure's page (fig3) from the tables")
     fg.add_argument("key", help="panel id like fig3/M, or a figure id like fig3 for its page")
     fg.add_argument("overrides", nargs="*")
     fg.add_argument("--results", type=Path, help="folder of the result tables (default results/{scale})")
     fg.add_argument("--out", type=Path, help="folder for the figures (default figures/{scale})")
+    rd = sub.add_parser("render", help="draw one episode of an assay as a clip (.gif; .mp4 with ffmpeg)")
+    rd.add_argument("overrides", nargs="*", help="config overrides; assay=<name> names the assay (e.g. homing)")
+    rd.add_argument("--condition", help="condition to draw (default: the assay's first)")
+    rd.add_argument("--episode", type=int, help="episode to draw (default: the condition's first)")
+    rd.add_argument("--tables", type=Path, help="folder of the assay's tables (default results/{run}/assays/{assay})")
+    rd.add_argument("--out", type=Path, help="the clip, .gif or .mp4 (default figures/{run}/clips/{assay}.gif)")
+    rd.add_argument("--every", type=int, help="draw every N-th step (default: the smallest N that plays in real "
+                                              "time and keeps the clip a few MB)")
+    rd.add_argument("--fps", type=float, help="frames per second (default env.fps / N: real time)")
+    rd.add_argument("--field", action="store_true", help="overlay |E| of the EODs discharged at each step "
+                                                         "(computed by the physics on a coarse grid)")
+    cs = sub.add_parser("contact-sheet", help="every registered panel's PNG as a thumbnail with its id")
+    cs.add_argument("overrides", nargs="*")
+    cs.add_argument("--figures", type=Path, help="figure folder of the run (default figures/{run})")
+    cs.add_argument("--out", type=Path, help="the sheet, a .png (default <figures>/contact_sheet.png)")
+    cl = sub.add_parser("claims", help="the claims of CLAIMS.md as verdicts from a run's tables")
+    cl.add_argument("overrides", nargs="*", help="config overrides, e.g. scale=smoke analysis.claims_resamples=200")
+    cl.add_argument("--results", type=Path, help="the run's results folder (default results/{run})")
+    cl.add_argument("--out", type=Path, help="folder for claims.parquet and claims.md (default <results>/claims)")
+    cc = sub.add_parser("compare-claims", help="two runs' claim verdicts and effect sizes side by side")
+    cc.add_argument("a", help="claims.parquet, a claims folder, or a run name (results/<name>/claims/claims.parquet)")
+    cc.add_argument("b", help="the same for the second run")
+    cc.set_defaults(overrides=[])
     b = sub.add_parser("bench", help="speed and accuracy studies")
     bsub = b.add_subparsers(dest="bench", required=True)
     bp = bsub.add_parser("physics", help="sensing throughput: fast path vs reference, one thread")
@@ -91,6 +132,10 @@ def _parser() -> argparse.ArgumentParser:
     ba.add_argument("overrides", nargs="*")
     ba.add_argument("--out", type=Path, default=Path("results/bench"), help="output folder (default results/bench)")
     ba.add_argument("--json", action="store_true", help="print the table as JSON records")
+    bs = bsub.add_parser("scaling", help="cost per agent-step against pellets and agents: table and figure")
+    bs.add_argument("overrides", nargs="*")
+    bs.add_argument("--out", type=Path, default=Path("results/bench"), help="output folder (default results/bench)")
+    bs.add_argument("--json", action="store_true", help="print the table as JSON records")
     return p
 
 
@@ -108,16 +153,17 @@ def _run_folder(cfg, args, root: str = "results") -> Path:
     return Path(root) / run_name(cfg.scale.name, [o for o in args.overrides if not o.startswith("scale=")])
 
 
-def _progress(items: list, label: str):
-    """tqdm bar on a terminal, one plain line per item otherwise."""
+def _progress(items: list, label: str, unit: str = "setting", every: int = 1):
+    """tqdm bar on a terminal, otherwise a plain line per ``every`` items (and after the last)."""
     if sys.stderr.isatty():
         from tqdm import tqdm
 
-        return tqdm(items, desc=label, unit="setting")
+        return tqdm(items, desc=label, unit=unit)
 
     def lines():
         for i, item in enumerate(items, 1):
-            print(f"{label}: {i}/{len(items)} {item}", file=sys.stderr, flush=True)
+            if i % every == 0 or i == len(items):
+                print(f"{label}: {i}/{len(items)} {item}", file=sys.stderr, flush=True)
             yield item
     return lines()
 
@@ -161,7 +207,7 @@ def _train(args, cfg, started) -> None:
     df = train(cfg, out, progress=report, restart=args.restart)
     if bar is not None:
         bar.close()
-    _metadata(out, cfg, started, args)
+    _metadata(out, cfg, started, args, compute=df.attrs["compute"])  # device, precision and how it was chosen
     print(f"trained {len(df)} updates into {out}")
 
 
@@ -208,6 +254,16 @@ def _select(args, cfg, started) -> None:
     print(f"selected seed {chosen}")
 
 
+def _stack_seeds(args, cfg, started) -> None:
+    from .analysis.selection import stack_top_seeds
+    from .io import atomic_path, read_parquet
+
+    table = stack_top_seeds(args.tables, read_parquet(args.ranking, "the seed ranking"))
+    with atomic_path(args.out) as tmp:
+        table.to_parquet(tmp, index=False)
+    print(f"wrote {args.out} ({len(table)} rows, seeds {sorted(table['seed'].unique().tolist())})")
+
+
 def _analyze(args, cfg, started) -> None:
     from .analysis.registry import read_tables, run
     from .io import write_parquet_tables
@@ -218,8 +274,51 @@ def _analyze(args, cfg, started) -> None:
     print(f"wrote {', '.join(f'{k}.parquet ({len(v)} rows)' for k, v in result.items())} to {args.out}")
 
 
+def _scene(args, cfg, started) -> None:
+    from .io import write_parquet_tables
+    from .rollout.scenes import build_scene, compose_scene, to_arrow
+
+    scene_cfg = compose_scene(args.name, args.overrides)
+    if scene_cfg.scene.name != args.name:
+        raise ValueError(f"config/scene/{args.name}.yaml names its scene {scene_cfg.scene.name!r}: they must agree")
+    table = build_scene(scene_cfg, args.overrides)
+    out = args.out or _run_folder(cfg, args) / "scenes"
+    write_parquet_tables({args.name: to_arrow(table)}, out)
+    # the folder holds every scene: one config (the run's) and one provenance per scene, with the scene resolved
+    _metadata(out, cfg, started, args, name=f"{args.name}.provenance.json", scene=args.name,
+              scene_config=dataclasses.asdict(scene_cfg.scene))
+    print(f"wrote {out / f'{args.name}.parquet'} ({len(table)} rows)")
+
+
+def _claims(args, cfg, started) -> None:
+    from .analysis.claims import claims_table
+    from .analysis.claims_report import claims_markdown
+    from .io import write_parquet_tables, write_text_atomic
+
+    results = args.results or _run_folder(cfg, args)
+    if not results.is_dir():
+        raise ValueError(f"results folder {results} does not exist")
+    out = args.out or results / "claims"
+    table = claims_table(results, cfg)
+    header = (f"Claims of the paper at scale {cfg.scale.name} (run {results.name}), "
+              f"{started.strftime('%Y-%m-%d %H:%M UTC')}")
+    write_parquet_tables({"claims": table}, out)
+    write_text_atomic(out / "claims.md", claims_markdown(table, header))
+    _metadata(out, cfg, started, args, results=str(results))
+    print(table[["claim", "panel", "effect", "ci_low", "ci_high", "n", "p", "verdict"]].to_string(
+        index=False, float_format=lambda v: f"{v:.3g}"))
+    print(f"wrote {out / 'claims.parquet'} and {out / 'claims.md'}")
+
+
+def _compare_claims(args) -> None:
+    from .analysis.claims_report import compare_claims, load_claims
+
+    (name_a, a), (name_b, b) = load_claims(args.a), load_claims(args.b)
+    print(compare_claims(a, b, (name_a, name_b)).to_string(index=False))
+
+
 def _figure(args, cfg, started) -> None:
-    from .figures.registry import figures, panels_for
+    from .figures.registry import drawable, figures
     from .figures.render import render_page, render_panel
 
     results = args.results or _run_folder(cfg, args)
@@ -231,12 +330,39 @@ def _figure(args, cfg, started) -> None:
     else:
         if args.key not in figures():
             raise ValueError(f"unknown figure {args.key!r}: choose one of {', '.join(figures())}, bench/accuracy")
-        drawable = [p for p in panels_for(cfg.scale.assays) if p.figure == args.key]
-        written = render_page(args.key, drawable, results, out, cfg.scale.seeds)
+        panels = [p for p in drawable(cfg.scale) if p.figure == args.key]
+        written = render_page(args.key, panels, results, out, cfg.scale.seeds)
     # one provenance per drawn output (a figure folder holds many panels), one config per folder
     _metadata(written[0].parent, cfg, started, args, name=f"{written[0].stem}.provenance.json", figure=args.key,
               results=str(results))
     print("wrote " + ", ".join(map(str, written)))
+
+
+def _render(args, cfg, started) -> None:
+    from .figures.episode import clip_writer, load_episode, render_clip
+
+    # assay= picks the tables, not the run: the default folders are the run's (results/smoke for scale=smoke)
+    run = argparse.Namespace(overrides=[o for o in args.overrides if not o.startswith("assay=")])
+    tables = args.tables or _run_folder(cfg, run) / "assays" / cfg.assay.name
+    out = args.out or _run_folder(cfg, run, root="figures") / "clips" / f"{cfg.assay.name}.gif"
+    clip_writer(out)  # a wrong suffix, or .mp4 without ffmpeg, fails before any table is read
+    episode = load_episode(tables, args.overrides, cfg, args.condition, args.episode)
+    frames = render_clip(episode, out, every=args.every, fps=args.fps, field=args.field,
+                         progress=lambda rows: _progress(rows, "frames", unit="frame", every=max(1, len(rows) // 10)))
+    _metadata(out.parent, cfg, started, args, name=f"{out.stem}.provenance.json", tables=str(tables),
+              condition=episode.condition, episode=episode.episode)
+    print(f"wrote {out} ({frames} frames of {episode.assay}, condition {episode.condition}, "
+          f"episode {episode.episode})")
+
+
+def _contact_sheet(args, cfg, started) -> None:
+    from .figures.contact_sheet import write_contact_sheet
+
+    figures = args.figures or _run_folder(cfg, args, root="figures")
+    out = args.out or figures / "contact_sheet.png"
+    drawn, absent = write_contact_sheet(figures, out)
+    _metadata(out.parent, cfg, started, args, name=f"{out.stem}.provenance.json", figures=str(figures))
+    print(f"wrote {out} (panels drawn: {drawn}; not drawn at this scale: {absent})")
 
 
 def _accuracy_figure(results: Path, out: Path) -> list[Path]:
@@ -289,6 +415,21 @@ def _bench_accuracy(args, cfg, started) -> None:
         print(f"wrote {args.out}/bench_accuracy.parquet and bench_accuracy.png/.pdf")
 
 
+def _bench_scaling(args, cfg, started) -> None:
+    from .bench.scaling import bench_scaling, format_scaling, plot_scaling
+    from .io import atomic_path
+
+    df = bench_scaling(cfg, progress=lambda c: _progress(c, "scaling", unit="case"))
+    args.out.mkdir(parents=True, exist_ok=True)
+    with atomic_path(args.out / "bench_scaling.parquet") as tmp:
+        df.to_parquet(tmp, index=False)
+    for ext in ("png", "pdf"):
+        with atomic_path(args.out / f"bench_scaling.{ext}") as tmp:
+            plot_scaling(df, tmp)
+    _metadata(args.out, cfg, started, args, name="bench_scaling.provenance.json")
+    print(df.to_json(orient="records", indent=1) if args.json else format_scaling(df))
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``efish`` console script."""
     args = _parser().parse_args(argv)
@@ -310,8 +451,20 @@ def main(argv: Sequence[str] | None = None) -> int:
             _assay(args, cfg, started)
         elif args.command == "analyze":
             _analyze(args, cfg, started)
+        elif args.command == "stack-seeds":
+            _stack_seeds(args, cfg, started)
         elif args.command == "figure":
             _figure(args, cfg, started)
+        elif args.command == "render":
+            _render(args, cfg, started)
+        elif args.command == "contact-sheet":
+            _contact_sheet(args, cfg, started)
+        elif args.command == "claims":
+            _claims(args, cfg, started)
+        elif args.command == "compare-claims":
+            _compare_claims(args)
+        elif args.command == "scene":
+            _scene(args, cfg, started)
         elif args.command == "plan":
             from .env.vec_env import scene_of
             from .physics.plan import build_plan
@@ -329,6 +482,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
             rows = bench_env(cfg, num_envs=args.envs, steps=args.steps)
             print(json.dumps(rows, indent=2) if args.json else format_env(rows))
+        elif args.bench == "scaling":
+            _bench_scaling(args, cfg, started)
         elif args.bench == "pipeline":
             from .bench.pipeline import format_timings, pipeline_timings
 

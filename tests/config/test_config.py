@@ -7,7 +7,7 @@ import pytest
 from efish.config import ConfigError, EfishConfig, compose, config_dir, to_yaml, validate
 from efish.config.schema import (
     AnalysisConfig, ArenaConfig, AssayConfig, BenchConfig, EnvConfig, PhysicsConfig, ScaleConfig, SensorsConfig,
-    TrainConfig,
+    SceneConfig, TrainConfig,
 )
 
 from ..helpers import cfg_with
@@ -122,7 +122,7 @@ def test_config_error_is_a_value_error():
 
 GROUPS = {"physics": PhysicsConfig, "sensors": SensorsConfig, "arena": ArenaConfig, "env": EnvConfig,
           "train": TrainConfig, "assay": AssayConfig, "bench": BenchConfig, "scale": ScaleConfig,
-          "analysis": AnalysisConfig}
+          "analysis": AnalysisConfig, "scene": SceneConfig}
 
 
 def _leaves(node, prefix=""):

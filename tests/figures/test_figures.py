@@ -6,6 +6,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from efish.analysis.behaviour import food_per_agent_episode
+from efish.analysis.behaviour import food_vs_size as fit_food_vs_size
 from efish.figures import fig3
 from efish.figures.registry import PANELS, figures, panels_for
 from efish.figures.render import input_paths, load_tables, render_page, render_panel
@@ -69,10 +71,15 @@ def test_unknown_panel_names_the_choices(tmp_path):
         render_panel("fig9/Z", tmp_path, tmp_path, seeds=1)
 
 
+def _food_tables(episodes: pd.DataFrame) -> dict[str, pd.DataFrame]:
+    """The behaviour analysis tables panel fig3/M reads: food per agent-episode and the OLS of food on size."""
+    return {"food_per_agent": food_per_agent_episode(episodes), "food_vs_size": fit_food_vs_size(episodes)}
+
+
 def test_food_vs_size_fits_the_known_line():
     with panel_style() as plt:
         fig, ax = plt.subplots()
-        fig3.food_vs_size({"episodes": episodes_table(n_episodes=10)}, ax)
+        fig3.food_vs_size(_food_tables(episodes_table(n_episodes=10)), ax)
         label = ax.get_legend().get_texts()[0].get_text()
         plt.close(fig)
     slope = float(label.split()[1].rstrip(","))
@@ -82,7 +89,7 @@ def test_food_vs_size_fits_the_known_line():
 def test_an_empty_table_is_said_on_the_panel():
     with panel_style() as plt:
         fig, ax = plt.subplots()
-        fig3.food_vs_size({"episodes": episodes_table().iloc[:0]}, ax)
+        fig3.food_vs_size(_food_tables(episodes_table().iloc[:0]), ax)
         texts = [t.get_text() for t in ax.texts]
         plt.close(fig)
     assert any(t.startswith("no data") for t in texts)

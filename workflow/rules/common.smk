@@ -185,4 +185,5 @@ def all_targets():
     targets += [f"figures/{RUN}/{p.figure}/{p.name}.{ext}" for p in DRAWABLE for ext in ("png", "pdf")]
     pages = {p.figure for p in DRAWABLE}
     targets += [f"figures/{RUN}/{fig}.{ext}" for fig in sorted(pages) for ext in ("png", "pdf")]
+    targets += render_targets()
     return targets

@@ -147,13 +147,16 @@ def _behaviour(t: Tables, cfg: EfishConfig) -> Tables:
     wins, eod, summary = win_ratios(episodes), eod_probability(steps), episode_summary(episodes)
     control = control_condition(summary["condition"], cfg)
     bites = _lacking(steps, ["bite_target"], ["bite_matrix"]) or {"bite_matrix": bite_matrix(steps)}
+    theil = theil_per_episode(episodes)
     return {
         "food_per_agent": food_per_agent_episode(episodes), "food_vs_size": food_vs_size(episodes),
-        "theil": theil_per_episode(episodes), "win_ratio": wins, **bites,
+        "theil": theil, "win_ratio": wins, **bites,
         "nearest_neighbour": nearest_neighbour(steps), "eod_probability": eod, "episode_summary": summary,
         "size_tests": pd.concat([spearman(wins, "size", "win_ratio", by="condition").assign(measure="win_ratio"),
                                  spearman(eod, "size", "eod_probability", by="condition")
-                                 .assign(measure="eod_probability")], ignore_index=True),
+                                 .assign(measure="eod_probability"),
+                                 spearman(theil, "size_theil_t", "theil_t", by="condition")  # Fig 3N
+                                 .assign(measure="theil_t")], ignore_index=True),
         "condition_tests": dunnett_by_measure(summary, SUMMARY_MEASURES, "condition", control, cfg.analysis.seed),
     }
 

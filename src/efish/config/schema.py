@@ -244,7 +244,14 @@ class TrainConfig:
                                         "one's checkpoint", lo=1, neutral=True)
     checkpoint_every: int = param(10, "updates between checkpoints", lo=1, neutral=True)
     threads: int = param(1, "torch threads", lo=1, hi=256, neutral=True)
-    bf16: bool = param(False, "bf16 autocast of forward passes (CPUs with bf16 support)")
+    precision: str = param("auto", "arithmetic of the update's forward passes: fp32, bf16 autocast, or auto (time "
+                           "the training GEMM in both at start, take the faster; recorded in provenance.json)",
+                           choices=("auto", "fp32", "bf16"))
+    bf16_speedup: float = param(1.2, "auto takes bf16 only when its GEMM runs at least this many times as fast as "
+                                "fp32 (near ties keep fp32's numerics)", lo=1.0, neutral=True)
+    device: str = param("cpu", "where the networks and the PPO update run (cuda: a GPU node); a resumed run may "
+                        "switch", choices=("cpu", "cuda"), neutral=True)
+    bf16: bool = param(False, "retired: use train.precision (true stops with that advice)")
     seed: int = param(1, "training seed", lo=0)
 
 
@@ -278,6 +285,15 @@ class BenchConfig:
     dtypes: list = param(["float64", "float32"], "kernel dtypes swept")
     softenings_m: list = param([1e-5, 1e-4, 1e-3], "softening lengths swept, m")
     seed: int = param(0, "seed of the benchmark scenes", lo=0)
+    scaling_sizes_cm: list = param([70.0, 140.0, 280.0, 560.0], "bench scaling: square arena sides at the "
+                                   "configured food density (the first is also the base of the other sweeps), cm")
+    scaling_crowded_multiplier: float = param(10.0, "bench scaling: food multiplier of the crowded case in the "
+                                              "first arena (0: no crowded case)", lo=0.0, hi=100.0)
+    scaling_agents: list = param([1, 2, 4, 8, 16], "bench scaling: agent counts swept in the first arena")
+    scaling_n_agents: int = param(4, "bench scaling: agents per arena in the pellet sweep", lo=1, hi=16)
+    scaling_envs: int = param(16, "bench scaling: arenas stepped together", lo=1)
+    scaling_agent_steps: int = param(2048, "bench scaling: agent-steps per timed call of the fast path", lo=1)
+    scaling_exact_agent_steps: int = param(64, "bench scaling: agent-steps per timed call at tolerance 0", lo=1)
 
 
 @dataclass
@@ -342,6 +358,53 @@ class AnalysisConfig:
     seed: int = param(0, "seed of unit subsampling, PLSC null shifts and Dunnett's p-values", lo=0)
     real_fish_idis: str = param("", "CSV or Parquet of real-fish IDIs (column idi_ms); empty: none, and the IDI "
                                 "tables say so in their reason column")
+    # claims (CLAIMS.md, ``efish claims``)
+    claims_resamples: int = param(1000, "claims: bootstrap resamples of episodes for each effect's interval", lo=1)
+    claims_fit_resamples: int = param(200, "claims: bootstrap resamples of a claim that refits a model per resample "
+                                      "(C4's power law; 1,000 fits take minutes at paper scale)", lo=1)
+    claims_seed: int = param(0, "claims: seed of the bootstrap (with the claim's number, so reruns are identical)",
+                             lo=0)
+    claims_alpha: float = param(0.05, "claims: a test is significant at p below this", lo=0.0, hi=1.0)
+    claims_aligned_rad: float = param(math.pi / 4, "claims C2: |error| within this of 0 or pi counts as aligned, "
+                                      "rad (chance fraction 2 x this / pi)", lo=0.0, hi=math.pi / 2)
+    claims_event_window: list = param([-10, 10], "claims C6: lags (steps) of the EOD rate around an event")
+    claims_baseline_window: list = param([-100, -50], "claims C6: lags (steps) of the baseline rate; within "
+                                         "+-peri_window")
+    claims_deff_fraction: float = param(0.5, "claims C17: D_eff / network width is below this when low-dimensional",
+                                        lo=0.0, hi=1.0)
+    claims_near_cm: float = param(10.0, "claims C21: a conspecific this close is near, cm", lo=0.0)
+    claims_far_cm: float = param(100.0, "claims C21: a conspecific farther than this is far, cm", lo=0.0)
+    claims_food_near_cm: float = param(10.0, "claims C19: food this close is in range for decoding, cm", lo=0.0)
+
+
+# ----------------------------------------------------------------------- scene
+@dataclass
+class SceneConfig:
+    """A field-map scene of Fig 1 and the sensing-range maps (``efish scene <name>``, files in config/scene/)."""
+
+    name: str = param("", "scene name, used in output paths (scenes/<name>.parquet); set by each scene file")
+    kind: str = param("field", "what is computed: field (EOD fields on a grid), sensing_range (how strongly each "
+                      "receptor class of an emitting agent detects a pellet or an agent around it), sensors "
+                      "(sensor positions on the body), food_layouts (pellets of the arena generators)",
+                      choices=("field", "sensing_range", "sensors", "food_layouts"))
+    arena_cm: list = param([60.0, 40.0], "arena [width, height], cm: where bodies may sit and, with walls, the "
+                           "insulating walls")
+    walls: bool = param(False, "mirror the sources in the arena's walls (physics.image_order, image_scale); "
+                        "false: free space")
+    window_cm: list = param([], "field grid [x0, x1, y0, y1], cm; empty: the whole arena")
+    resolution_cm: float = param(0.5, "field grid spacing, cm", lo=1e-3)
+    agents: list = param([[30.0, 20.0, 0.0, 1]], "agents as [x_cm, y_cm, heading_rad, emitting (0/1)]; the first "
+                         "is the focal agent (sensors)")
+    pellets: list = param([], "pellets as [x_cm, y_cm, orientation_rad]")
+    range_cm: list = param([1.2, 200.0], "sensing_range: [nearest, farthest] target distance from the focal "
+                           "agent's centre, cm (log-spaced)")
+    range_points: int = param(60, "sensing_range: log-spaced target distances", lo=2, hi=10_000)
+    bearings: int = param(72, "sensing_range: target bearings, evenly around the focal agent", lo=4, hi=10_000)
+    targets: list = param(["pellet", "agent"], "sensing_range: targets placed around the focal agent (pellet: "
+                          "Mormyromast, Ampullary; agent, emitting: all three classes)")
+    layouts: list = param([], "food_layouts: one [name, override, ...] per layout, e.g. [patchy, arena=patchy70]: "
+                          "the config overrides of its arena")
+    seed: int = param(0, "food_layouts: seed of the arena and pellet draws", lo=0)
 
 
 @dataclass
@@ -357,6 +420,7 @@ class EfishConfig:
     bench: BenchConfig = group(BenchConfig)
     scale: ScaleConfig = group(ScaleConfig)
     analysis: AnalysisConfig = group(AnalysisConfig)
+    scene: SceneConfig = group(SceneConfig)
 
 
 # Groups whose values a training run depends on; the rest (assay, bench, scale, analysis) only name or size other
@@ -425,6 +489,8 @@ def _check_consistency(obj: Any, path: str) -> None:
     """Cross-field rules that a single range cannot express."""
     if isinstance(obj, AssayConfig) and not obj.conditions:
         raise ConfigError(f"{path}conditions is empty: an assay needs at least one condition")
+    if isinstance(obj, TrainConfig) and obj.bf16:
+        raise ConfigError(f"{path}bf16 is retired: set {path}precision=bf16 (or auto, fp32) instead")
     if isinstance(obj, TrainConfig) and obj.rollout_steps % obj.chunk:
         raise ConfigError(f"{path}chunk={obj.chunk} must divide {path}rollout_steps={obj.rollout_steps}")
     if isinstance(obj, EnvConfig):
@@ -458,6 +524,8 @@ def _check_consistency(obj: Any, path: str) -> None:
             raise ConfigError(f"{path}far_field_levels={levels} must hold increasing odd counts in [3, 63]")
     if isinstance(obj, AnalysisConfig):
         _check_analysis(obj, path)
+    if isinstance(obj, SceneConfig):
+        _check_scene(obj, path)
     if isinstance(obj, (MormyromastConfig, AmpullaryConfig)) and not 0 < obj.e_min < obj.e_max:
         raise ConfigError(f"{path}e_min={obj.e_min:g} must be > 0 and below {path}e_max={obj.e_max:g}")
     if isinstance(obj, MormyromastConfig) and obj.chin_count > obj.count:
@@ -485,3 +553,23 @@ def _check_analysis(obj: AnalysisConfig, path: str) -> None:
     edges = list(obj.plsc_edges_cm)
     if edges != sorted(set(edges)) or any(e < 0 for e in edges):
         raise ConfigError(f"{path}plsc_edges_cm={edges} must be increasing distances >= 0")
+
+
+def _check_scene(obj: SceneConfig, path: str) -> None:
+    """Cross-field rules of the scene group: shapes of the arena, window and body lists."""
+    if len(obj.arena_cm) != 2 or min(obj.arena_cm) <= 0:
+        raise ConfigError(f"{path}arena_cm={list(obj.arena_cm)} must be [width, height] with both > 0")
+    w = obj.window_cm
+    if w and (len(w) != 4 or not (w[0] < w[1] and w[2] < w[3])):
+        raise ConfigError(f"{path}window_cm={list(w)} must be [] or [x0, x1, y0, y1] with x0 < x1 and y0 < y1")
+    if any(len(a) != 4 for a in obj.agents) or not obj.agents:
+        raise ConfigError(f"{path}agents must hold at least one [x_cm, y_cm, heading_rad, emitting]")
+    if any(len(p) != 3 for p in obj.pellets):
+        raise ConfigError(f"{path}pellets must hold [x_cm, y_cm, orientation_rad] entries")
+    if len(obj.range_cm) != 2 or not 0 < obj.range_cm[0] < obj.range_cm[1]:
+        raise ConfigError(f"{path}range_cm={list(obj.range_cm)} must be [nearest, farthest] with 0 < nearest < farthest")
+    names = [layout[0] for layout in obj.layouts if layout]
+    if len(names) != len(obj.layouts) or len(set(names)) != len(names):
+        raise ConfigError(f"{path}layouts must hold [name, override, ...] entries with distinct names")
+    if any(t not in ("pellet", "agent") for t in obj.targets):
+        raise ConfigError(f"{path}targets={list(obj.targets)} must name pellet or agent")

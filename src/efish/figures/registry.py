@@ -11,8 +11,10 @@ from __future__ import annotations
 from . import fig1, fig2, fig3, fig4, fig5, fig6, supplement
 from .panel import Panel
 
-PANELS: dict[str, Panel] = {p.key: p for module in (fig1, fig2, fig3, fig4, fig5, fig6, supplement)
-                            for p in module.PANELS}
+_ALL = [p for module in (fig1, fig2, fig3, fig4, fig5, fig6, supplement) for p in module.PANELS]
+PANELS: dict[str, Panel] = {p.key: p for p in _ALL}
+if len(PANELS) != len(_ALL):  # two modules registering one key: the dict would silently keep the last
+    raise ImportError(f"panel keys registered twice: {sorted({p.key for p in _ALL if sum(q.key == p.key for q in _ALL) > 1})}")
 
 __all__ = ["PANELS", "Panel", "drawable", "figures", "panels_for"]
 

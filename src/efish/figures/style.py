@@ -24,7 +24,7 @@ CONDITION_COLOURS = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56
 #: Size classes from small to large (ranks within an episode, or the one-patch A-vs-B classes): one
 #: sequential palette, light = small, dark = large.
 SIZE_CLASS_CMAP = "viridis_r"
-ONEPATCH_CLASS_COLOURS = {"A_lt_B": "#440154", "A_eq_B": "#21918c", "A_gt_B": "#fde725",
+ONEPATCH_CLASS_COLOURS = {"A_lt_B": "#440154", "A_eq_B": "#21918c", "A_gt_B": "#b89b00",
                           "A_alone": "#7f7f7f", "B_alone": "#bfbfbf"}
 #: Sequential colour map of every heat map (bite matrices, field maps use their own diverging one).
 HEATMAP_CMAP = "rocket_r"
@@ -107,3 +107,96 @@ def finite(values) -> np.ndarray:
     """The finite entries of ``values`` as floats (NaN rows of analysis tables carry a ``reason`` instead)."""
     x = np.asarray(values, dtype=float)
     return x[np.isfinite(x)]
+
+
+# ----------------------------------------------- shared drawing patterns (Figs 4-6)
+#: Group sizes N = 1, 2, ... (the groupsize assay) on one sequential ramp, distinct from the size-class one.
+GROUP_SIZE_CMAP = "crest"
+
+
+def group_size_colours(sizes: Iterable[int]) -> dict:
+    """Colour per group size, light (smallest N) to dark (largest N), the same in every panel."""
+    import matplotlib
+    import seaborn  # noqa: F401  (registers "crest" with matplotlib)
+
+    sizes = sorted({int(s) for s in sizes})
+    cmap = matplotlib.colormaps[GROUP_SIZE_CMAP]
+    return {s: cmap(0.15 + 0.75 * i / max(len(sizes) - 1, 1)) for i, s in enumerate(sizes)}
+
+
+def box_strip(ax, data: pd.DataFrame, x: str, y: str, order: list, palette: dict,
+              stars: dict | None = None, labels: dict | None = None) -> bool:
+    """One box (no fliers) per ``x`` category in ``order`` with every value of ``y`` as a point on it.
+
+    ``stars`` maps a category to the text drawn above it (read by the caller
+    from an analysis statistic table, never computed here); ``labels`` maps a
+    category to its tick label. A category without a finite value keeps its
+    place (an empty slot). When no category has a finite value the panel says
+    so (the first non-empty ``reason`` of ``data``) and False is returned.
+    """
+    import warnings
+
+    import seaborn as sns
+
+    if x not in data or y not in data:
+        raise ValueError(f"box_strip needs columns {x!r} and {y!r}, the table has {list(data.columns)}")
+    frame = data[data[x].isin(order)]
+    frame = frame.assign(**{y: pd.to_numeric(frame[y], errors="coerce")})
+    values = finite(frame[y])
+    if not values.size:
+        reasons = [r for r in data.get("reason", pd.Series(dtype=str)).astype(str) if r and r != "nan"]
+        missing(ax, reasons[0] if reasons else f"no finite {y}")
+        return False
+    common = {"data": frame, "x": x, "y": y, "order": order, "hue": x, "hue_order": order, "palette": palette,
+              "legend": False, "ax": ax}
+    with warnings.catch_warnings():
+        # seaborn 0.13 passes matplotlib's deprecated ``vert`` to boxplot (a warning from matplotlib 3.11 on)
+        warnings.filterwarnings("ignore", message="vert: bool was deprecated", category=DeprecationWarning)
+        sns.boxplot(**common, fill=False, showfliers=False, width=0.6, linewidth=0.8)
+    sns.stripplot(**common, size=3, jitter=0.2, alpha=0.8, linewidth=0.3, edgecolor="white")
+    if stars:
+        lo, hi = float(values.min()), float(values.max())
+        pad = (hi - lo) * 0.06 or max(abs(hi), 1.0) * 0.06
+        for i, group in enumerate(order):
+            if group in stars:
+                top = finite(frame.loc[frame[x] == group, y])
+                annotate_stars(ax, i, (top.max() if top.size else hi) + pad, stars[group])
+        ax.set_ylim(top=hi + 4 * pad)
+    ax.set_xticks(range(len(order)), [(labels or {}).get(g, str(g)) for g in order])
+    return True
+
+
+def mean_lines(ax, data: pd.DataFrame, x: str, y: str, hue: str, palette: dict, styles: dict | None = None) -> bool:
+    """Every value of ``y`` against a numeric ``x`` as faint points, and the mean +- SEM per ``hue`` as a line.
+
+    The ``hue`` levels (those of ``palette`` present in the data, in its order)
+    are shifted apart along x by a tenth of the smallest x step so that equal
+    means stay visible; ``styles`` maps a level to a line style (e.g. Knollenorgans
+    off dashed). When no value is finite the panel says so and False is returned.
+    """
+    frame = data.assign(**{y: pd.to_numeric(data[y], errors="coerce")}).dropna(subset=[y])
+    if frame.empty:
+        reasons = [r for r in data.get("reason", pd.Series(dtype=str)).astype(str) if r and r != "nan"]
+        missing(ax, reasons[0] if reasons else f"no finite {y}")
+        return False
+    levels = [h for h in palette if h in set(frame[hue])]
+    xs = np.unique(frame[x].to_numpy(float))
+    step = float(np.diff(xs).min()) if len(xs) > 1 else 1.0
+    rng = np.random.default_rng(0)  # fixed jitter: the same drawing on every run
+    for i, level in enumerate(levels):
+        sub = frame[frame[hue] == level]
+        shift = (i - (len(levels) - 1) / 2) * 0.1 * step
+        jitter = rng.uniform(-0.03, 0.03, len(sub)) * step
+        ax.scatter(sub[x].to_numpy(float) + shift + jitter, sub[y], s=5, color=palette[level], alpha=0.4,
+                   edgecolors="none")
+        stats = sub.groupby(x)[y].agg(["mean", "sem"])
+        ax.errorbar(stats.index.to_numpy(float) + shift, stats["mean"].to_numpy(float),
+                    yerr=stats["sem"].fillna(0.0).to_numpy(float),
+                    color=palette[level], marker="o", ms=3, capsize=2, lw=1.0, ls=(styles or {}).get(level, "-"),
+                    label=str(level))
+    ax.set_xticks(xs)
+    return True
+
+
+#: Food pellets wherever they are drawn (episode clips, scenes): brown, apart from every agent colour.
+PELLET_COLOUR = "#8c564b"

@@ -1,0 +1,152 @@
+"""Fig 5 panels: roles come from the assay configs, every panel renders, drawn values are the tables' values."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from efish.analysis.interactions import LABELS
+from efish.config import compose
+from efish.figures import fig5
+from efish.figures.registry import PANELS
+from efish.figures.render import load_tables, render_panel
+from efish.figures.style import panel_style
+
+FIG5 = [key for key in PANELS if key.startswith("fig5/")]
+ARENA_MAPS = {"fig5/A", "fig5/B", "fig5/C", "fig5/D"}
+
+
+def draw(key: str, results, tables=None):
+    """Draw panel ``key`` on a fresh axes from ``results`` (or the given ``tables``); the axes, its figure closed."""
+    panel = PANELS[key]
+    tables = load_tables(panel, results, seeds=2) if tables is None else tables
+    with panel_style() as plt:
+        fig = plt.figure()
+        ax = fig.add_subplot()
+        panel.draw(tables, ax)
+        plt.close(fig)  # its artists stay readable; an open figure per test would pile up
+    return ax
+
+
+def point_values(ax) -> np.ndarray:
+    """The y of every scattered point on ``ax`` (seaborn strip points are PathCollections)."""
+    ys = [c.get_offsets()[:, 1] for c in ax.collections if len(c.get_offsets())]
+    return np.sort(np.concatenate(ys)) if ys else np.array([])
+
+
+def test_every_letter_of_spec_13_is_registered():
+    assert sorted(k.split("/")[1] for k in FIG5) == list("ABCDEFGHIJKLMNOP")
+
+
+def test_roles_follow_the_onepatch_config():
+    roles = fig5.onepatch_roles()
+    for cond, extra in compose(["assay=onepatch"]).assay.conditions.items():
+        alone = "env.n_agents=1" in extra
+        assert len(roles[cond]) == (1 if alone else 2), cond
+    assert roles["A_lt_B"] == {"A": 0, "B": 1}
+    assert roles["B_alone"] == {"B": 0} and roles["A_alone"] == {"A": 0}
+
+
+def test_role_rows_picks_b_in_each_condition_and_rejects_bad_roles():
+    table = pd.DataFrame({"condition": ["A_lt_B", "A_lt_B", "B_alone", "A_alone"], "agent": [0, 1, 0, 0],
+                          "v": [1, 2, 3, 4]})
+    rows = fig5.role_rows(table, "B")
+    assert rows["v"].tolist() == [2, 3]
+    assert "A_alone" not in rows["condition"].cat.categories
+    with pytest.raises(ValueError, match="role must be"):
+        fig5.role_rows(table, "C")
+
+
+def test_bot_conditions_read_size_rate_and_mobility_from_the_config():
+    bots = fig5.bot_conditions().set_index("condition")
+    assert len(bots) == 30 and set(bots["agent"]) == {1}
+    row = bots.loc["bot0.25_B0.75_rate0.5_frozen"]
+    assert (row["size_class"], row["bot_eod_rate"], row["mobility"]) == ("A_lt_B", 0.5, "frozen")
+    assert bots.loc["bot0.75_B0.25_rate0_moving", "mobility"] == "moving"
+    assert bots.loc["bot0.5_B0.5_rate1_moving", "class_label"] == "bot=B"
+
+
+@pytest.mark.parametrize("key", FIG5)
+def test_panel_renders_with_labelled_axes(key, synthetic_results, tmp_path):
+    written = render_panel(key, synthetic_results, tmp_path, seeds=2)
+    assert [p.suffix for p in written] == [".png", ".pdf"]
+    ax = draw(key, synthetic_results)
+    texts = [t.get_text() for t in ax.texts]
+    if not any(t.startswith("no data") for t in texts):
+        assert ax.get_xlabel() and ax.get_ylabel(), key
+    if key in ARENA_MAPS:
+        assert (ax.get_xlabel(), ax.get_ylabel()) == ("x (cm)", "y (cm)")
+
+
+def test_scene_shows_the_first_episode_at_its_first_step(synthetic_results):
+    tables = load_tables(PANELS["fig5/A"], synthetic_results, 2)
+    ax = draw("fig5/A", synthetic_results, tables)
+    steps, food = tables["steps"], tables["food"]
+    episode = steps.loc[steps["condition"] == "A_lt_B", "episode"].min()
+    start = steps[(steps["condition"] == "A_lt_B") & (steps["episode"] == episode) & (steps["t"] == 0)]
+    bodies = {tuple(np.round(line.get_xydata()[0], 4)) for line in ax.get_lines()}
+    assert {tuple(np.round(xy, 4)) for xy in start[["x_cm", "y_cm"]].to_numpy(float)} <= bodies
+    pellets = food[(food["condition"] == "A_lt_B") & (food["episode"] == episode) & (food["t_spawned"] <= 0)]
+    assert ax.child_axes[0].get_title() == f"{len(pellets)} pellets at t=0"
+
+
+def test_food_of_b_draws_b_food_of_every_condition(synthetic_results):
+    tables = load_tables(PANELS["fig5/E"], synthetic_results, 2)
+    food = tables["food"]
+    expected = fig5.role_rows(food, "B")["food_eaten"].to_numpy(float)
+    ax = draw("fig5/E", synthetic_results, tables)
+    assert np.array_equal(point_values(ax), np.sort(expected))
+    labels = [t.get_text() for t in ax.get_xticklabels()]
+    assert labels == ["A<B", "A=B", "A>B", "B alone"]
+
+
+def test_food_time_course_lines_are_the_table_means(synthetic_results):
+    tables = load_tables(PANELS["fig5/H"], synthetic_results, 2)
+    ax = draw("fig5/H", synthetic_results, tables)
+    course = tables["course"]
+    mine = course[(course["condition"] == "A_alone") & (course["agent"] == 0)].sort_values("t")
+    line = next(line for line in ax.get_lines() if line.get_label() == "A alone")
+    assert np.allclose(line.get_ydata(), mine["mean_food"])
+    fps = compose(["assay=onepatch"]).env.fps
+    assert np.allclose(line.get_xdata(), mine["t"] / fps)
+
+
+def test_bot_reach_draws_only_the_trained_agent(synthetic_results):
+    tables = load_tables(PANELS["fig5/I"], synthetic_results, 2)
+    reach = tables["reach"]
+    ax = draw("fig5/I", synthetic_results, tables)
+    expected = reach.loc[reach["agent"] == 1, "reach_rate"].to_numpy(float)
+    assert np.allclose(point_values(ax), np.sort(expected))
+
+
+def test_biter_panels_read_stars_from_size_tests(synthetic_results):
+    tables = load_tables(PANELS["fig5/M"], synthetic_results, 2)
+    assert len(tables["events"]) > 1  # the synthetic pairs bite (they need not chase)
+    tests = tables["tests"]
+    tests = tests.assign(stars=np.where(tests["measure"] == "bite", "XSTARX", tests["stars"]))
+    ax = draw("fig5/M", synthetic_results, {**tables, "tests": tests})
+    assert any("XSTARX" in t.get_text() for t in ax.texts)
+    assert sum(p.get_height() for p in ax.patches) == pytest.approx(len(tables["events"]))
+    ax = draw("fig5/N", synthetic_results, {**tables, "tests": tests})
+    assert any(t.get_text() == "XSTARX" for t in ax.texts)
+
+
+def test_bite_rate_bars_are_the_table_rates(synthetic_results):
+    tables = load_tables(PANELS["fig5/P"], synthetic_results, 2)
+    rate = tables["rate"].set_index("label")["rate"]
+    ax = draw("fig5/P", synthetic_results, tables)
+    heights = [p.get_height() for p in ax.patches]
+    expected = rate.reindex(LABELS).to_numpy(float)
+    assert np.allclose(heights, expected[np.isfinite(expected)])  # a label never seen has no bar ...
+    unseen = int(np.sum(~np.isfinite(expected)))
+    assert sum(t.get_text() == "n/a" for t in ax.texts) == unseen  # ... but says so
+
+
+def test_nan_only_table_says_why_on_the_panel():
+    nan_row = pd.DataFrame([{"condition": np.nan, "episode": np.nan, "size_difference": np.nan,
+                             "reason": "no chasing bout"}])
+    tests = pd.DataFrame(columns=["measure", "condition", "group", "stars", "effect"])
+    for key in ("fig5/K", "fig5/L"):
+        ax = draw(key, None, {"events": nan_row, "tests": tests})
+        assert any("no chasing bout" in t.get_text() for t in ax.texts)
