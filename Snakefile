@@ -18,6 +18,7 @@ include: "workflow/rules/analysis.smk"
 include: "workflow/rules/scenes.smk"
 include: "workflow/rules/figures.smk"
 include: "workflow/rules/render.smk"
+include: "workflow/rules/claims.smk"
 
 
 rule all:

@@ -186,4 +186,5 @@ def all_targets():
     pages = {p.figure for p in DRAWABLE}
     targets += [f"figures/{RUN}/{fig}.{ext}" for fig in sorted(pages) for ext in ("png", "pdf")]
     targets += render_targets()
+    targets += [f"results/{RUN}/claims/claims.parquet", f"results/{RUN}/claims/claims.md"]
     return targets

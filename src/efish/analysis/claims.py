@@ -1,0 +1,691 @@
+"""The paper's claims as verdicts (CLAIMS.md): one function per claim C1..C21, a registry, the claims table.
+
+Each claim function takes the tables it names (a dict keyed by the path under
+``results/{run}/``, e.g. ``analysis/homing/homing/trajectory_shape.parquet``)
+and the composed config, and returns one row of :data:`ROW_COLUMNS`: claim,
+panel, statistic, effect, 95% bootstrap interval, n, p, verdict, reason. The
+verdict rules and the combination of a claim's parts are in
+:mod:`efish.analysis.claim_parts`. A statistic an analysis table already holds
+(a Dunnett row, a Wilcoxon of sizes, a power-law fit) is read, not recomputed;
+the interval resamples episodes of the table it rests on. A table the run lacks
+makes that part ``not run`` with a reason naming it, never an exception.
+
+:data:`CLAIMS` names, per claim, the tables it reads; ``efish claims`` and the
+``claims`` rule of the workflow read it, and :func:`claims_table` runs all.
+
+Condition names are those of ``config/assay/<assay>.yaml``.
+"""
+
+from __future__ import annotations
+
+import functools
+import re
+from collections.abc import Callable, Iterable, Mapping
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from scipy import stats as sps
+
+from ..config.schema import AssayConfig, EfishConfig
+from ..io import read_parquet
+from ._tables import AGENT_EPISODE, eod_rate
+from .claim_parts import (
+    CLAIMS,
+    ROW_COLUMNS,
+    Context,
+    Outcome,
+    Part,
+    analysis_table,
+    claim,
+    fisher_rates,
+    from_row,
+    heldout_skill,
+    joined,
+    mann_whitney_part,
+    mean_diff,
+    median_minus,
+    ols_part,
+    one_sample_part,
+    paired_skill,
+    present,
+    rho_of,
+    rollout_table,
+    slope,
+    spearman_part,
+    stat_row,
+)
+from .dynamics import DECODE_TARGETS, plsc, wideband_power
+from .homing import error_angles
+from .interactions import bite_rate_by_class
+from .registry import ANALYSES, tables_written
+from .signalling import EVENTS, peri_event_rate
+from .stats import spearman, wilcoxon_paired
+
+__all__ = ["CLAIMS", "ROW_COLUMNS", "claim_tables", "claims_table", "produced_tables"]
+
+
+# ---------------------------------------------------------- shared tests
+def _dunnett(ctx: Context, assay: str, condition: str, control: str, measure: str, sign: int) -> Outcome:
+    """The behaviour analysis's Dunnett row (mean difference vs control), interval over its episode summary."""
+    tests = ctx.table(analysis_table("behaviour", assay, "condition_tests"))
+    summary = ctx.table(analysis_table("behaviour", assay, "episode_summary"))
+    row = stat_row(tests, measure=measure, group=condition, control=control)
+    sub = summary[summary["condition"].isin([condition, control])]
+    return from_row(row, sign, ctx.ci(sub, mean_diff(measure, "condition", condition, control)))
+
+
+# --------------------------------------------------------------- Fig 2
+HOMING_ELECTRIC, HOMING_RAYCAST = "electric", "raycast"  # config/assay/homing.yaml
+TRAJECTORY = analysis_table("homing", "homing", "trajectory_shape")
+HOMING_STEPS, HOMING_HIDDEN = rollout_table("homing", "steps"), rollout_table("homing", "hidden")
+
+
+def _successful(frame: pd.DataFrame) -> pd.DataFrame:
+    """Rows of agent-episodes that ended with their goal reached (every row when there is no success column)."""
+    if "success" not in frame.columns:
+        return frame
+    ok = frame.groupby(AGENT_EPISODE)["success"].transform("any").astype(bool)
+    return frame[ok.to_numpy()]
+
+
+@claim("C1", "2B", "electric homing paths are curvilinear, ray-casting paths straight", [TRAJECTORY])
+def c1(ctx: Context) -> list[Part]:
+    def compute() -> Outcome:
+        shape = ctx.table(TRAJECTORY)
+        shape = shape[np.isfinite(shape["tortuosity"])]  # the frozen target never moves: no tortuosity
+        if (shape := _successful(shape)).empty:
+            raise ValueError("no successful homing episode with a tortuosity")
+        return mann_whitney_part(ctx, shape, "tortuosity", "condition", HOMING_ELECTRIC, HOMING_RAYCAST, +1)
+    return [ctx.part("tortuosity", "median tortuosity (path / displacement) of successful homing episodes, "
+                     "electric minus raycast; Mann-Whitney", compute)]
+
+
+def _knollen_errors(ctx: Context) -> pd.DataFrame:
+    """The homer's Knollenorgan error angles (long table of :func:`error_angles`) in the electric condition."""
+    steps = ctx.table(HOMING_STEPS)
+    steps = steps[steps["condition"] == HOMING_ELECTRIC]
+    err = error_angles(steps) if "err_knollen_rad" in steps.columns else pd.DataFrame()
+    err = err[err["channel"] == "knollen"] if len(err) else err
+    if err.empty:
+        raise ValueError("no finite Knollenorgan error angle in the electric homing steps")
+    return err
+
+
+@claim("C2", "2C", "the error angle is bimodal near parallel and anti-parallel to the target's field",
+       [HOMING_STEPS])
+def c2(ctx: Context) -> list[Part]:
+    a = ctx.cfg.analysis.claims_aligned_rad
+    chance = 2 * a / np.pi  # P(|cos e| > cos a) for a uniform angle e
+
+    def compute() -> Outcome:
+        err = _knollen_errors(ctx)
+        per = (err.assign(aligned=np.abs(np.cos(err["err_rad"])) > np.cos(a))
+               .groupby(["episode", "agent"], as_index=False)["aligned"].agg(k="sum", n="size"))
+        k, n = int(per["k"].sum()), int(per["n"].sum())
+        p = sps.binomtest(k, n, chance).pvalue
+        ci = ctx.ci(per, lambda d: d["k"].sum() / d["n"].sum() - chance)
+        return Outcome(k / n - chance, p, n, +1, ci, f"aligned fraction {k / n:.3f} vs chance {chance:.3f}")
+    return [ctx.part("aligned fraction", f"fraction of homing steps with |cos(err_knollen)| > cos({a:.3g}) minus "
+                     "its chance value; binomial test", compute)]
+
+
+@claim("C3", "2D", "error angles align progressively during successful episodes", [HOMING_STEPS])
+def c3(ctx: Context) -> list[Part]:
+    def compute() -> Outcome:
+        err = _successful(_knollen_errors(ctx).merge(
+            ctx.table(HOMING_STEPS)[[*AGENT_EPISODE, "t", "success"]], on=[*AGENT_EPISODE, "t"]))
+        if err.empty:
+            raise ValueError("no successful electric homing episode")
+        err = err.assign(abs_sin=np.abs(np.sin(err["err_rad"])), unit=err["episode"] * 1000 + err["agent"])
+        rho = spearman(err, "t_norm", "abs_sin", by="unit")
+        rho = rho.assign(episode=rho["group"] // 1000)[np.isfinite(rho["effect"])]
+        return one_sample_part(ctx, rho, "effect", 0.0, -1)
+    return [ctx.part("alignment", "median over successful episodes of Spearman rho(|sin err_knollen|, normalised "
+                     "time); Wilcoxon vs 0", compute)]
+
+
+# --------------------------------------------------------------- Fig 3
+POWER_LAW, IDIS = analysis_table("signalling", "wide2", "power_law"), analysis_table("signalling", "wide2", "idis")
+
+
+def _r_exponential(idi_ms: np.ndarray, xmin: float) -> float:
+    """powerlaw's normalised loglikelihood ratio power law vs exponential (as in fit_power_law), for resamples."""
+    import warnings
+
+    import powerlaw
+
+    x = idi_ms[np.isfinite(idi_ms) & (idi_ms > 0)]
+    if np.sum(x >= xmin) < 10 or np.ptp(x[x >= xmin]) == 0:
+        return np.nan
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the point estimate's fit reports powerlaw's warnings
+        return float(powerlaw.Fit(x, xmin=xmin, verbose=False).distribution_compare(
+            "power_law", "exponential", normalized_ratio=True)[0])
+
+
+@claim("C4", "3C,D", "IDIs are heavy-tailed, power-law-like", [POWER_LAW, IDIS])
+def c4(ctx: Context) -> list[Part]:
+    def compute() -> Outcome:
+        fits = ctx.table(POWER_LAW)
+        row = stat_row(fits, source="agents")
+        xmin = float(row["xmin"])
+        ids = ctx.table(IDIS)
+        ids = ids[ids["condition"] == row["condition"]] if "condition" in ids.columns else ids
+        ci = ctx.ci(ids, lambda d: _r_exponential(d["idi_ms"].to_numpy(np.float64), xmin),
+                    resamples=ctx.cfg.analysis.claims_fit_resamples)
+        note = f"alpha {float(row['alpha']):.3g}, xmin {xmin:g} ms" if np.isfinite(row["alpha"]) else ""
+        return Outcome(float(row["R_exponential"]), float(row["p_exponential"]), int(row["n"]), +1, ci,
+                       note if np.isfinite(row["R_exponential"]) else str(row.get("reason") or note))
+    return [ctx.part("power law", "normalised loglikelihood ratio R, power law vs exponential, IDIs >= xmin "
+                     "(wide2); powerlaw's p", compute)]
+
+
+WIDE2_STEPS, WIDE2_HIDDEN = rollout_table("wide2", "steps"), rollout_table("wide2", "hidden")
+WIDE2_EPISODES = rollout_table("wide2", "episodes")
+
+
+def _kruskal_eta(d: pd.DataFrame) -> tuple[float, float, int]:
+    """Kruskal-Wallis of ``rate`` over ``bin``: epsilon^2 = (H - k + 1) / (n - k), p, n; NaN when undefined."""
+    samples = [g.to_numpy() for _, g in d.groupby("bin")["rate"]]
+    n, k = sum(len(s) for s in samples), len(samples)
+    if k < 2 or n <= k or np.ptp(d["rate"]) == 0:
+        return np.nan, np.nan, n
+    h, p = sps.kruskal(*samples)
+    return float((h - k + 1) / (n - k)), float(p), n
+
+
+@claim("C5", "3E-G", "the EOD rate varies with distance to agent, food and wall", [WIDE2_STEPS])
+def c5(ctx: Context) -> list[Part]:
+    a = ctx.cfg.analysis
+
+    def compute(to: str) -> Outcome:
+        steps = ctx.table(WIDE2_STEPS)
+        dist = steps[f"dist_{to}_cm"].to_numpy(np.float64)
+        edges = np.linspace(0.0, getattr(a, f"{to}_range_cm"), a.rate_bins + 1)
+        frame = steps[AGENT_EPISODE].assign(rate=eod_rate(steps, a.rate_window, ctx.cfg.env.fps),
+                                            bin=np.clip(np.searchsorted(edges, dist, side="right") - 1, 0,
+                                                        a.rate_bins - 1))
+        frame = frame[np.isfinite(frame["rate"]) & (dist >= edges[0]) & (dist <= edges[-1])]
+        # one sample per agent-episode and bin (its mean rate): steps of one episode are not independent
+        per = frame.groupby([*AGENT_EPISODE, "bin"])["rate"].agg(["mean", "size"])
+        per = per[per["size"] >= a.min_samples]["mean"].rename("rate").reset_index()
+        if per.empty:
+            raise ValueError(f"no agent-episode has {a.min_samples} steps in a {to} distance bin")
+        eta, p, n = _kruskal_eta(per)
+        reason = "" if np.isfinite(p) else "fewer than 2 distance bins with data, or a constant rate"
+        return Outcome(eta, p, n, None, ctx.ci(per, lambda d: _kruskal_eta(d)[0]), reason)
+    stat = ("Kruskal-Wallis of the mean EOD rate per agent-episode and distance bin across the SPEC 12 bins "
+            "(wide2); effect epsilon^2")
+    return [ctx.part(to, stat, functools.partial(compute, to)) for to in ("agent", "food", "wall")]
+
+
+@claim("C6", "3H-J", "the EOD rate rises around eating, builds before biting, rises around being bitten",
+       [WIDE2_STEPS])
+def c6(ctx: Context) -> list[Part]:
+    a = ctx.cfg.analysis
+    (e0, e1), (b0, b1) = a.claims_event_window, a.claims_baseline_window
+
+    def compute(event: str) -> Outcome:
+        if max(abs(e0), abs(e1), abs(b0), abs(b1)) > a.peri_window:
+            raise ValueError(f"the windows reach beyond analysis.peri_window = {a.peri_window} steps")
+        steps = ctx.table(WIDE2_STEPS)
+        # one peri-event curve per agent-episode: peri_event_rate averages within a condition, so each
+        # agent-episode becomes its own condition here
+        unit = steps["condition"].astype(str) + "|" + steps["episode"].astype(str) + "|" + steps["agent"].astype(str)
+        curves = peri_event_rate(steps.assign(condition=unit), event, a.peri_window, a.min_events, a.rate_window,
+                                 ctx.cfg.env.fps)
+        curves = curves[curves["n_agents"] > 0]
+        if curves.empty:
+            raise ValueError(f"no agent-episode has {a.min_events} or more '{event}' events")
+        lag = curves["lag"]
+        near = curves[(lag >= e0) & (lag <= e1)].groupby("condition")["mean_hz"].mean()
+        base = curves[(lag >= b0) & (lag <= b1)].groupby("condition")["mean_hz"].mean()
+        diff = (near - base).dropna().rename("diff").reset_index()
+        diff["episode"] = diff["condition"].str.rsplit("|", n=2).str[1]
+        return one_sample_part(ctx, diff, "diff", 0.0, +1)
+    stat = (f"median over agent-episodes of the mean EOD rate at lags [{e0}, {e1}] minus [{b0}, {b1}] steps of "
+            "the event (wide2); Wilcoxon vs 0")
+    return [ctx.part(event, stat, functools.partial(compute, event)) for event in EVENTS]
+
+
+def _size_roles(ctx: Context, assay: str, measure: str, sizes: str) -> Outcome:
+    """The interactions analysis's Wilcoxon of chaser/biter vs chased/bitten size, interval over its events."""
+    row = stat_row(ctx.table(analysis_table("interactions", assay, "size_tests")), measure=measure)
+    events = ctx.table(analysis_table("interactions", assay, sizes))
+    ci = ctx.ci(events.dropna(subset=["size_difference"]), median_minus("size_difference", 0.0))
+    return from_row(row, +1, ci)
+
+
+@claim("C7", "3K,L; 5M,N", "larger agents bite smaller ones; the win ratio rises with size",
+       [analysis_table("interactions", a, t) for a in ("patchy4", "square2") for t in ("size_tests", "bite_sizes")]
+       + [analysis_table("behaviour", "patchy4", "win_ratio")])
+def c7(ctx: Context) -> list[Part]:
+    stat = "median biter minus bitten size over bites; Wilcoxon signed-rank"
+    parts = [ctx.part(f"biter larger, {assay}", stat, functools.partial(_size_roles, ctx, assay, "bite",
+                                                                         "bite_sizes"))
+             for assay in ("patchy4", "square2")]
+
+    def win() -> Outcome:
+        return ols_part(ctx, ctx.table(analysis_table("behaviour", "patchy4", "win_ratio")), "size", "win_ratio", +1)
+    return parts + [ctx.part("win ratio slope, patchy4", "OLS slope of win ratio on size over agent-episodes", win)]
+
+
+@claim("C8", "3M,N", "larger agents eat more; Theil T of food tracks size inequality",
+       [analysis_table("behaviour", "patchy4", t) for t in ("food_vs_size", "food_per_agent", "theil")])
+def c8(ctx: Context) -> list[Part]:
+    def food() -> Outcome:
+        row = ctx.table(analysis_table("behaviour", "patchy4", "food_vs_size")).iloc[0]
+        per = ctx.table(analysis_table("behaviour", "patchy4", "food_per_agent"))
+        return from_row(row, +1, ctx.ci(per, lambda d: slope(d["size"], d["food_eaten"])))
+
+    def theil() -> Outcome:
+        return ols_part(ctx, ctx.table(analysis_table("behaviour", "patchy4", "theil")), "size_theil_t", "theil_t", +1)
+    return [ctx.part("food ~ size", "OLS slope of food eaten on size over agent-episodes (patchy4)", food),
+            ctx.part("Theil ~ size Theil", "OLS slope of episode Theil T(food) on Theil T(size) (patchy4)", theil)]
+
+
+@claim("C9", "3O", "size correlates positively with EOD rate",
+       [analysis_table("behaviour", "patchy4", t) for t in ("size_tests", "eod_probability")])
+def c9(ctx: Context) -> list[Part]:
+    def compute() -> Outcome:
+        row = stat_row(ctx.table(analysis_table("behaviour", "patchy4", "size_tests")), measure="eod_probability")
+        eod = ctx.table(analysis_table("behaviour", "patchy4", "eod_probability"))
+        return from_row(row, +1, ctx.ci(eod, rho_of("size", "eod_probability")))
+    return [ctx.part("rho", "Spearman rho(size, EOD probability) over agent-episodes (patchy4)", compute)]
+
+
+# --------------------------------------------------------------- Fig 4
+# ablation conditions are named by the receptor classes left on (config/assay/ablation4.yaml)
+ALL_ON, M_OFF, A_OFF, K_OFF = "M_A_K", "A_K", "M_K", "M_A"
+BEHAVIOUR = ("condition_tests", "episode_summary")
+
+
+def _dunnett_parts(ctx: Context, assay: str, control: str, specs) -> list[Part]:
+    stat = "mean difference of the episode {m} vs {c}; Dunnett"
+    return [ctx.part(label, stat.format(m=measure, c=control),
+                     functools.partial(_dunnett, ctx, assay, cond, control, measure, sign))
+            for label, cond, measure, sign in specs]
+
+
+@claim("C10", "4A-F", "short-range ablations cut food; Knollenorgan ablation keeps food, raises EOD probability "
+       "and biting, lowers spacing", [analysis_table("behaviour", a, t) for a in ("ablation4", "ablation1")
+                                      for t in BEHAVIOUR])
+def c10(ctx: Context) -> list[Part]:
+    return (_dunnett_parts(ctx, "ablation4", ALL_ON, [
+        ("group food, M off", M_OFF, "food_total", -1), ("group food, A off", A_OFF, "food_total", -1)])
+        + _dunnett_parts(ctx, "ablation1", ALL_ON, [
+            ("solo food, M off", M_OFF, "food_total", -1), ("solo food, A off", A_OFF, "food_total", -1)])
+        + _dunnett_parts(ctx, "ablation4", ALL_ON, [
+            ("group food, K off (n.s.)", K_OFF, "food_total", 0), ("EOD probability, K off", K_OFF,
+                                                                   "eod_probability", +1),
+            ("bites, K off", K_OFF, "bites", +1), ("nearest-neighbour distance, K off", K_OFF, "mean_nn_dist_cm",
+                                                   -1)]))
+
+
+@claim("C11", "4G,H", "self-only gating cuts food, cons-only does not; EOD lower in self-only, higher in cons-only",
+       [analysis_table("behaviour", "collective", t) for t in BEHAVIOUR])
+def c11(ctx: Context) -> list[Part]:
+    return _dunnett_parts(ctx, "collective", "control", [  # config/assay/collective.yaml
+        ("food, self-only", "self_only", "food_total", -1), ("food, cons-only (n.s.)", "cons_only", "food_total", 0),
+        ("EOD probability, self-only", "self_only", "eod_probability", -1),
+        ("EOD probability, cons-only", "cons_only", "eod_probability", +1)])
+
+
+@claim("C12", "4I,J", "muting one agent cuts group food and raises spacing",
+       [analysis_table("behaviour", "mute", "episode_summary")])
+def c12(ctx: Context) -> list[Part]:
+    def compute(measure: str, sign: int) -> Outcome:
+        summary = ctx.table(analysis_table("behaviour", "mute", "episode_summary"))
+        return mann_whitney_part(ctx, summary, measure, "condition", "muted", "intact", sign)  # config/assay/mute.yaml
+    stat = "median episode {} muted minus intact; Mann-Whitney"
+    return [ctx.part("group food", stat.format("food_total"), functools.partial(compute, "food_total", -1)),
+            ctx.part("spacing", stat.format("mean_nn_dist_cm"), functools.partial(compute, "mean_nn_dist_cm", +1))]
+
+
+NPATCH = re.compile(r"(iso|free)_(\d+)$")  # config/assay/npatch.yaml
+
+
+def _npatch(ctx: Context) -> pd.DataFrame:
+    """The iso episodes of the N-patch sweep with n, Theil T and food / mean food of the free series at that n."""
+    s = ctx.table(analysis_table("behaviour", "npatch", "episode_summary"))
+    m = s["condition"].astype(str).str.extract(NPATCH)
+    s = s.assign(series=m[0], n=pd.to_numeric(m[1]))
+    free = s[s["series"] == "free"].groupby("n")["food_total"].mean()
+    iso = s[s["series"] == "iso"]
+    if iso.empty or free.empty:
+        raise ValueError("the N-patch summary lacks the iso or the free series")
+    return iso.assign(food_ratio=iso["food_total"] / iso["n"].map(free).where(lambda v: v > 0))
+
+
+@claim("C13", "4K-N", "patchy food yields more than uniform, Theil n.s.; fewer patches at fixed total food lower "
+       "intake and inequality", [analysis_table("behaviour", a, "episode_summary")
+                                 for a in ("patchy4", "uniform4", "npatch")])
+def c13(ctx: Context) -> list[Part]:
+    def layouts(measure: str, sign: int) -> Outcome:
+        both = pd.concat([ctx.table(analysis_table("behaviour", a, "episode_summary")).assign(layout=a)
+                          for a in ("patchy4", "uniform4")], ignore_index=True)
+        return mann_whitney_part(ctx, both.drop(columns="condition").rename(columns={"layout": "condition"}), measure,
+                             "condition", "patchy4", "uniform4", sign)
+
+    def sweep(value: str) -> Outcome:
+        return spearman_part(ctx, _npatch(ctx), "n", value, +1)
+    stat = "median episode {} patchy4 minus uniform4; Mann-Whitney"
+    return [ctx.part("food, patchy vs uniform", stat.format("food_total"), functools.partial(layouts, "food_total",
+                                                                                               +1)),
+            ctx.part("Theil, patchy vs uniform (n.s.)", stat.format("theil_t"), functools.partial(layouts, "theil_t",
+                                                                                                    0)),
+            ctx.part("iso/free food vs n", "Spearman rho of iso food / mean free food at n against n patches",
+                     functools.partial(sweep, "food_ratio")),
+            ctx.part("iso Theil vs n", "Spearman rho of iso-series Theil T against n patches",
+                     functools.partial(sweep, "theil_t"))]
+
+
+# --------------------------------------------------------------- Fig 5
+ONEPATCH_FOOD = analysis_table("behaviour", "onepatch", "food_per_agent")
+# config/assay/onepatch.yaml: agent 0 is resident A, agent 1 intruder B; alone, the one agent (0) is A or B
+SOCIAL = ("A_gt_B", "A_eq_B", "A_lt_B")  # B's size rising
+
+
+def _roles(food: pd.DataFrame) -> pd.DataFrame:
+    """food_per_agent of the one-patch assay with ``role`` A or B and ``setting`` (social condition or alone)."""
+    alone = food["condition"].isin(["A_alone", "B_alone"])
+    role = np.where(alone, food["condition"].str[0], np.where(food["agent"] == 0, "A", "B"))
+    return food.assign(role=role, setting=np.where(alone, "alone", food["condition"]))
+
+
+@claim("C14", "5E-H", "intruder B eats more with A present than alone; A is unaffected; B does better when larger",
+       [ONEPATCH_FOOD])
+def c14(ctx: Context) -> list[Part]:
+    def b_social(condition: str) -> Outcome:
+        b = _roles(ctx.table(ONEPATCH_FOOD)).query("role == 'B'")
+        return mann_whitney_part(ctx, b, "food_eaten", "setting", condition, "alone", +1)
+
+    def a_social() -> Outcome:
+        a = _roles(ctx.table(ONEPATCH_FOOD)).query("role == 'A'")
+        a = a.assign(setting=np.where(a["setting"] == "alone", "alone", "social"))
+        return mann_whitney_part(ctx, a, "food_eaten", "setting", "social", "alone", 0)
+
+    def b_size() -> Outcome:
+        b = _roles(ctx.table(ONEPATCH_FOOD)).query("role == 'B' and setting != 'alone'")
+        return spearman_part(ctx, b[b["setting"].isin(SOCIAL)], "size", "food_eaten", +1)
+    stat = "median food of B with A ({}) minus B alone; Mann-Whitney"
+    return ([ctx.part(f"B social, {c}", stat.format(c), functools.partial(b_social, c)) for c in SOCIAL]
+            + [ctx.part("A social vs alone (n.s.)", "median food of A with B minus A alone; Mann-Whitney", a_social),
+               ctx.part("B food vs B size", "Spearman rho of B's food against B's size over the social conditions",
+                        b_size)])
+
+
+BOT_REACH = analysis_table("onepatch", "bot", "reach_rates")
+BOT = re.compile(r"rate([0-9.]+)_(frozen|moving)$")  # config/assay/bot.yaml
+BOT_B = 1  # the bot is agent 0, the trained agent B is agent 1
+
+
+def _reach(ctx: Context, group: Callable[[pd.DataFrame], pd.Series], a: str, b: str) -> Outcome:
+    """B's reach rate in group ``a`` minus ``b`` (pooled episodes), Fisher's exact test, interval over episodes."""
+    r = ctx.table(BOT_REACH)
+    r = r[r["agent"] == BOT_B]
+    m = r["condition"].astype(str).str.extract(BOT)
+    r = r.assign(rate=pd.to_numeric(m[0]), motion=m[1]).dropna(subset=["rate"])
+    r = r.assign(group=group(r))
+    counts = r.groupby("group")[["n_reached", "n_episodes"]].sum()
+    present(counts.reset_index(), "group", [a, b], "bot episodes")
+    diff, p = fisher_rates(*counts.loc[a].astype(int), *counts.loc[b].astype(int))
+    # one row per episode (reached or not): the reach table's counts, resampled as episodes
+    per = pd.DataFrame([{"condition": g, "episode": i, "reached": i < k}
+                        for g, (k, n) in counts.astype(int).iterrows() for i in range(n)])
+    ci = ctx.ci(per.assign(reached=per["reached"].astype(float)), mean_diff("reached", "condition", a, b))
+    return Outcome(diff, p, int(counts["n_episodes"].sum()), +1, ci)
+
+
+@claim("C15", "5I,J", "B reaches the patch more often when the bot is frozen, and when it emits than when silent",
+       [BOT_REACH])
+def c15(ctx: Context) -> list[Part]:
+    frozen = functools.partial(_reach, ctx, lambda r: r["motion"], "frozen", "moving")
+    emits = functools.partial(_reach, ctx, lambda r: np.where(r["rate"] > 0, "emitting", "silent"), "emitting",
+                              "silent")
+    return [ctx.part("frozen vs moving bot", "B's reach rate with the bot frozen minus moving; Fisher exact", frozen),
+            ctx.part("emitting vs silent bot", "B's reach rate with bot EOD rate > 0 minus rate 0; Fisher exact",
+                     emits)]
+
+
+SQUARE2_STEPS = rollout_table("square2", "steps")
+
+
+def _confronting(ctx: Context) -> Outcome:
+    """Bite rate of confronting pair-steps minus the next-highest class, Fisher exact, interval over episodes."""
+    a, steps = ctx.cfg.analysis, ctx.table(SQUARE2_STEPS)
+    # bite_rate_by_class sums over a condition; each episode as its own condition gives per-episode counts
+    per = bite_rate_by_class(steps.assign(condition=steps["episode"]), a.bout_cm, a.facing_rad, a.away_rad)
+    per = per.rename(columns={"condition": "episode"}).dropna(subset=["label"])
+    per = per[per["label"] != "undefined"]
+    total = per.groupby("label")[["bites", "n_steps"]].sum()
+    total = total[total["n_steps"] > 0]
+    if "confronting" not in total.index or len(total) < 2:
+        raise ValueError("no confronting pair-step, or no other class, within range")
+    rates = total["bites"] / total["n_steps"]
+    other = rates.drop("confronting").idxmax()
+    diff, p = fisher_rates(*total.loc["confronting"].astype(int), *total.loc[other].astype(int))
+
+    def stat(d: pd.DataFrame) -> float:
+        s = d.groupby("label")[["bites", "n_steps"]].sum()
+        r = s["bites"] / s["n_steps"].where(s["n_steps"] > 0)
+        return float(r.get("confronting", np.nan) - r.get(other, np.nan))
+    return Outcome(diff, p, int(total["n_steps"].sum()), +1, ctx.ci(per, stat, strata=None),
+                   f"next-highest class: {other}")
+
+
+@claim("C16", "5K-P", "larger agents chase; biting peaks early in bouts; confronting bouts bite most",
+       [analysis_table("interactions", "square2", t) for t in ("size_tests", "chase_sizes", "bite_timing")]
+       + [SQUARE2_STEPS])
+def c16(ctx: Context) -> list[Part]:
+    def timing() -> Outcome:
+        bites = ctx.table(analysis_table("interactions", "square2", "bite_timing"))
+        return one_sample_part(ctx, bites.dropna(subset=["phase"]), "phase", 0.5, -1)
+    return [ctx.part("chaser larger", "median chaser minus chased size over chasing bouts (square2); Wilcoxon",
+                     functools.partial(_size_roles, ctx, "square2", "chase", "chase_sizes")),
+            ctx.part("bites early", "median normalised bite time in its bout minus 0.5; Wilcoxon", timing),
+            ctx.part("confronting bites most", "bite rate per pair-step within range, confronting minus the "
+                     "next-highest class; Fisher exact", functools.partial(_confronting, ctx))]
+
+
+# --------------------------------------------------------------- Fig 6
+GROUPSIZE = re.compile(r"n(\d+)_(K|noK)$")  # config/assay/groupsize.yaml
+
+
+@claim("C17", "6A-C", "hidden dynamics are low-dimensional; D_eff grows with group size only with Knollenorgans",
+       [analysis_table("dynamics", a, "dimensionality") for a in ("patchy4", "groupsize")])
+def c17(ctx: Context) -> list[Part]:
+    a, width = ctx.cfg.analysis, ctx.cfg.train.hidden
+
+    def low() -> Outcome:
+        dims = ctx.table(analysis_table("dynamics", "patchy4", "dimensionality"))
+        dims = dims.assign(fraction=dims["d_eff"] / width).dropna(subset=["fraction"])
+        return one_sample_part(ctx, dims, "fraction", a.claims_deff_fraction, -1)
+
+    def grows(knollen: str, sign: int) -> Outcome:
+        dims = ctx.table(analysis_table("dynamics", "groupsize", "dimensionality"))
+        m = dims["condition"].astype(str).str.extract(GROUPSIZE)
+        dims = dims.assign(n_agents=pd.to_numeric(m[0]), k=m[1])
+        return spearman_part(ctx, dims[dims["k"] == knollen], "n_agents", "d_eff", sign)
+    return [ctx.part("low-dimensional", f"median D_eff / width ({width}) minus {a.claims_deff_fraction} (patchy4); "
+                     "Wilcoxon", low),
+            ctx.part("D_eff grows with N, K on", "Spearman rho(D_eff, N) over agent-episodes, Knollenorgans on",
+                     functools.partial(grows, "K", +1)),
+            ctx.part("K off (n.s.)", "Spearman rho(D_eff, N) over agent-episodes, Knollenorgans off",
+                     functools.partial(grows, "noK", 0))]
+
+
+@claim("C18", "6D", "the Knollenorgan error angle is decoded better than the straight bearing to the target",
+       [HOMING_HIDDEN, HOMING_STEPS])
+def c18(ctx: Context) -> list[Part]:
+    def compute() -> Outcome:
+        j, h = joined(ctx, HOMING_HIDDEN, HOMING_STEPS, ["err_knollen_rad", "bearing_agent_rad"])
+        j = j[(j["condition"] == HOMING_ELECTRIC) & np.isfinite(j["err_knollen_rad"])]  # the homer's steps
+        if j.empty:
+            raise ValueError("no electric homing step with a Knollenorgan error angle and a hidden state")
+        skills = heldout_skill(j[h].to_numpy(), {"err_knollen_rad": (j["err_knollen_rad"].to_numpy(), True),
+                                                 "bearing_agent_rad": (j["bearing_agent_rad"].to_numpy(), True)},
+                               j["episode"].to_numpy(), ctx.cfg.analysis.decode_folds)
+        return paired_skill(ctx, skills, "err_knollen_rad", "bearing_agent_rad")
+    return [ctx.part("err vs bearing", "median over episodes of held-out decoding skill (1 - MSE / MSE of the "
+                     "train mean) of err_knollen minus bearing to the target; Wilcoxon", compute)]
+
+
+AGENT_FEATURES = ("dist_agent_cm", "n_knollen_agents")  # nearest-agent distance and the Knollenorgan feature
+FOOD_FEATURES = ("dist_food_cm", "bearing_food_rad")
+
+
+@claim("C19", "6E,F", "nearest-agent distance and Knollenorgan features decode best; food variables decode better "
+       "when food is in range", [WIDE2_HIDDEN, WIDE2_STEPS])
+def c19(ctx: Context) -> list[Part]:
+    folds = ctx.cfg.analysis.decode_folds
+
+    def ranking() -> Outcome:
+        j, h = joined(ctx, WIDE2_HIDDEN, WIDE2_STEPS, [c for c in DECODE_TARGETS
+                                                       if c in ctx.table(WIDE2_STEPS).columns])
+        targets = [c for c in DECODE_TARGETS if c in j.columns and j[c].notna().mean() > 0.5]
+        j = j.dropna(subset=targets)
+        skills = heldout_skill(j[h].to_numpy(), {c: (j[c].to_numpy(), DECODE_TARGETS[c]) for c in targets},
+                               j["episode"].to_numpy(), folds)
+        mean = skills.groupby("target")["skill"].mean()
+        ours, rest = mean.reindex(AGENT_FEATURES).dropna(), mean.drop(list(AGENT_FEATURES), errors="ignore")
+        if ours.empty or rest.empty:
+            raise ValueError("no agent or no other decoding target with finite skill")
+        out = paired_skill(ctx, skills, ours.idxmax(), rest.idxmax())
+        return Outcome(**{**out.__dict__, "reason": out.reason or f"best {ours.idxmax()} vs best other "
+                                                                  f"{rest.idxmax()}"})
+
+    def food() -> Outcome:
+        j, h = joined(ctx, WIDE2_HIDDEN, WIDE2_STEPS, list(FOOD_FEATURES))
+        j = j.dropna(subset=list(FOOD_FEATURES))
+        parts = []
+        for name, sub in (("near", j[j["dist_food_cm"] <= ctx.cfg.analysis.claims_food_near_cm]),
+                          ("far", j[j["dist_food_cm"] > ctx.cfg.analysis.claims_food_near_cm])):
+            s = heldout_skill(sub[h].to_numpy(), {c: (sub[c].to_numpy(), DECODE_TARGETS[c]) for c in FOOD_FEATURES},
+                              sub["episode"].to_numpy(), folds)
+            parts.append(s.groupby("group", as_index=False)["skill"].mean().assign(target=name))
+        return paired_skill(ctx, pd.concat(parts, ignore_index=True), "near", "far")
+    return [ctx.part("agent features best", "median over episodes of held-out skill of the best agent feature "
+                     "minus the best other target (wide2); Wilcoxon", ranking),
+            ctx.part("food near > far", "median over episodes of held-out skill of food distance and bearing, "
+                     "food in range minus out of range; Wilcoxon", food)]
+
+
+WIDE2_PLSC = analysis_table("dynamics", "wide2", "plsc")
+
+
+def _pair_hidden(ctx: Context) -> tuple[pd.DataFrame, pd.DataFrame, list[str]]:
+    """Agents 0 and 1 of wide2 at their shared steps (same rows), with their distance ``dist_cm``."""
+    j, h = joined(ctx, WIDE2_HIDDEN, WIDE2_STEPS, ["x_cm", "y_cm"])
+    keys = ["condition", "episode", "t"]
+    a, b = (j[j["agent"] == i].set_index(keys) for i in (0, 1))
+    shared = a.index.intersection(b.index)
+    if shared.empty:
+        raise ValueError("agents 0 and 1 of wide2 share no step with a hidden state")
+    a, b = a.loc[shared], b.loc[shared]
+    dist = np.hypot(a["x_cm"] - b["x_cm"], a["y_cm"] - b["y_cm"]).rename("dist_cm")
+    return a.assign(dist_cm=dist).reset_index(), b.reset_index(), h
+
+
+@claim("C20", "6G,H", "the PLSC first-component correlation falls with pair distance; significant dimensions "
+       "collapse beyond 100 cm", [WIDE2_HIDDEN, WIDE2_STEPS, WIDE2_PLSC])
+def c20(ctx: Context) -> list[Part]:
+    edges = [-np.inf, *ctx.cfg.analysis.plsc_edges_cm, np.inf]
+
+    def falls() -> Outcome:
+        a, b, h = _pair_hidden(ctx)
+        rows = []
+        for (cond, ep), idx in a.groupby(["condition", "episode"]).indices.items():
+            d = a["dist_cm"].to_numpy()[idx]
+            for k in range(len(edges) - 1):
+                keep = idx[(d > edges[k]) & (d <= edges[k + 1])]
+                # shifts=1: only the first component's correlation is used, not the null
+                res = plsc(a[h].to_numpy()[keep], b[h].to_numpy()[keep], shifts=1, rng=ctx.rng)
+                rows.append({"condition": cond, "episode": ep, "bin": k, "r1": res["correlations"][0]})
+        return spearman_part(ctx, pd.DataFrame(rows).dropna(), "bin", "r1", -1)
+
+    def collapse() -> Outcome:
+        t = ctx.table(WIDE2_PLSC).dropna(subset=["n_significant"])
+        near, far = t[t["lo_cm"] == t["lo_cm"].min()], t[np.isinf(t["hi_cm"])]
+        if near.empty or far.empty:
+            raise ValueError("the PLSC table has no nearest or no farthest distance bin with a result")
+        d = float(far["n_significant"].iloc[0] - near["n_significant"].iloc[0])
+        verdict = "holds" if d < 0 else "fails" if d > 0 else "weaker"
+        return Outcome(d, np.nan, int(near["n_steps"].iloc[0] + far["n_steps"].iloc[0]), -1, verdict=verdict,
+                       reason=f"n_significant {int(near['n_significant'].iloc[0])} near, "
+                              f"{int(far['n_significant'].iloc[0])} far (a criterion: no p, no interval)")
+    return [ctx.part("r1 falls with distance", "Spearman rho of the PLSC first-component correlation per episode "
+                     "and distance bin against the bin (wide2)", falls),
+            ctx.part("collapse beyond the last edge", "n_significant(farthest bin) minus n_significant(nearest bin), "
+                     "pooled PLSC (wide2)", collapse)]
+
+
+@claim("C21", "6I,J", "a nearby conspecific lowers wideband power; smaller agents carry more",
+       [WIDE2_HIDDEN, WIDE2_STEPS, analysis_table("dynamics", "wide2", "dimensionality"), WIDE2_EPISODES])
+def c21(ctx: Context) -> list[Part]:
+    a = ctx.cfg.analysis
+
+    def near_far() -> Outcome:
+        j, h = joined(ctx, WIDE2_HIDDEN, WIDE2_STEPS, ["dist_agent_cm"])
+        rows = []
+        for keys, sub in j.groupby(AGENT_EPISODE):
+            d = sub["dist_agent_cm"].to_numpy()
+            for where, keep in (("near", d <= a.claims_near_cm), ("far", d > a.claims_far_cm)):
+                power = wideband_power(sub[h].to_numpy()[keep], a.spectrogram_window, a.spectrogram_overlap,
+                                       ctx.cfg.env.fps)
+                rows.append({**dict(zip(AGENT_EPISODE, keys, strict=True)), "where": where, "power": power})
+        long = pd.DataFrame(rows).dropna(subset=["power"])
+        long = long.assign(unit=long["episode"].astype(str) + "|" + long["agent"].astype(str))
+        present(long, "where", ["near", "far"], "hidden states long enough for a spectrogram")
+        row = wilcoxon_paired(long, "power", "where", "near", "unit").iloc[0]
+        wide = long.pivot(index=["episode", "agent"], columns="where", values="power")
+        diff = (wide["far"] - wide["near"]).dropna().rename("diff").reset_index()
+        return from_row(row, +1, ctx.ci(diff, median_minus("diff", 0.0), strata=None))
+
+    def smaller() -> Outcome:
+        dims = ctx.table(analysis_table("dynamics", "wide2", "dimensionality"))
+        sizes = ctx.table(WIDE2_EPISODES)[AGENT_EPISODE + ["size"]]
+        d = dims.merge(sizes, on=AGENT_EPISODE)
+        rank = d.groupby(["condition", "episode"])["size"].rank(method="min")
+        equal = d.groupby(["condition", "episode"])["size"].transform("nunique") < 2
+        d = d.assign(role=np.where(rank == 1, "smaller", "larger"))[~equal.to_numpy()]
+        return mann_whitney_part(ctx, d.dropna(subset=["wideband_power"]), "wideband_power", "role", "smaller",
+                             "larger", +1)
+    return [ctx.part("far > near", f"median over agent-episodes of wideband power with the conspecific beyond "
+                     f"{a.claims_far_cm:g} cm minus within {a.claims_near_cm:g} cm; Wilcoxon", near_far),
+            ctx.part("smaller carries more", "median wideband power of the smaller minus the larger agent per "
+                     "episode (wide2); Mann-Whitney", smaller)]
+
+
+# ------------------------------------------------------------------ API
+def claim_tables() -> list[str]:
+    """Every table some claim reads, as paths under ``results/{run}/``, sorted."""
+    return sorted({t for c in CLAIMS.values() for t in c.tables})
+
+
+def produced_tables(assays: Mapping[str, AssayConfig]) -> set[str]:
+    """The tables a run of these assays writes (rollout and analysis), as paths under ``results/{run}/``."""
+    out = set()
+    for name, assay in assays.items():
+        written = tables_written(assay)
+        out |= {rollout_table(name, t) for t in written}
+        out |= {analysis_table(a.name, name, t) for a in ANALYSES.values()
+                if name in a.assays and set(a.reads) <= set(written) for t in a.outputs}
+    return out
+
+
+def read_claim_tables(results: str | Path, paths: Iterable[str]) -> dict[str, pd.DataFrame]:
+    """The tables among ``paths`` that exist under ``results`` (a missing one is simply absent)."""
+    results = Path(results)
+    return {p: read_parquet(results / p, p) for p in paths if (results / p).is_file()}
+
+
+def claims_table(results: str | Path, cfg: EfishConfig, claims: Iterable[str] | None = None) -> pd.DataFrame:
+    """One row per claim (all of CLAIMS, or ``claims``) from the tables under ``results`` (``results/{run}``)."""
+    chosen = list(CLAIMS) if claims is None else list(claims)
+    if unknown := [c for c in chosen if c not in CLAIMS]:
+        raise ValueError(f"unknown claims {unknown}: choose among {', '.join(CLAIMS)}")
+    tables = read_claim_tables(results, {t for c in chosen for t in CLAIMS[c].tables})
+    rows = [CLAIMS[c].run({t: tables[t] for t in CLAIMS[c].tables if t in tables}, cfg) for c in chosen]
+    return pd.DataFrame(rows, columns=ROW_COLUMNS).astype({"n": "int64"})

@@ -1,0 +1,72 @@
+"""Claims tables for people: the markdown page of one run, and two runs side by side (``efish compare-claims``).
+
+A claims table is the output of :func:`efish.analysis.claims.claims_table`
+(``results/{run}/claims/claims.parquet``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..io import read_parquet
+from .claim_parts import VERDICTS, markdown_table
+
+
+def _num(x: float) -> str:
+    return f"{x:.3g}" if np.isfinite(x) else "-"
+
+
+def _effects(table: pd.DataFrame) -> list[str]:
+    """``effect [ci_low, ci_high]`` per row, the effect alone where there is no interval."""
+    return [f"{_num(e)} [{_num(lo)}, {_num(hi)}]" if np.isfinite(lo) else _num(e)
+            for e, lo, hi in zip(table["effect"], table["ci_low"], table["ci_high"], strict=True)]
+
+
+def claims_markdown(table: pd.DataFrame, header: str) -> str:
+    """The claims table as markdown under a ``header`` line: claim, panel, statistic, effect [95% CI], n, p, verdict,
+    reason (what the README quotes and the Snakemake report shows)."""
+    shown = pd.DataFrame({
+        "claim": table["claim"], "panel": table["panel"], "statistic": table["statistic"],
+        "effect [95% CI]": _effects(table), "n": table["n"], "p": [_num(p) for p in table["p"]],
+        "verdict": table["verdict"], "reason": table["reason"]})
+    counts = table["verdict"].value_counts()
+    summary = ", ".join(f"{counts[v]} {v}" for v in VERDICTS if v in counts)
+    return f"{header}\n\n{summary}.\n\n{markdown_table(shown)}"
+
+
+def load_claims(where: str | Path, results_root: str | Path = "results") -> tuple[str, pd.DataFrame]:
+    """A claims table and its run's name from a claims.parquet path, a claims folder, or a run name.
+
+    A run name ``NAME`` means ``<results_root>/NAME/claims/claims.parquet``.
+    ValueError (one line) when none of these is a file.
+    """
+    where = Path(where)
+    candidates = [where, where / "claims.parquet", Path(results_root) / where / "claims" / "claims.parquet"]
+    path = next((c for c in candidates if c.is_file()), None)
+    if path is None:
+        raise ValueError(f"no claims table for {str(where)!r}: tried {', '.join(map(str, candidates))} "
+                         "(run efish claims first)")
+    run = path.parent.parent.name if path.parent.name == "claims" else path.parent.name
+    return run, read_parquet(path, f"the claims table {path}")
+
+
+def compare_claims(a: pd.DataFrame, b: pd.DataFrame, names: tuple[str, str] = ("A", "B")) -> pd.DataFrame:
+    """Two claims tables side by side, one row per claim: each run's verdict and effect [95% CI], and whether the
+    verdict moved. A claim only one table has shows '-' on the other side."""
+    def side(t: pd.DataFrame, name: str) -> pd.DataFrame:
+        return pd.DataFrame({"claim": t["claim"], "panel": t["panel"], f"{name} verdict": t["verdict"],
+                             f"{name} effect [95% CI]": _effects(t), f"{name} n": t["n"]})
+
+    if names[0] == names[1]:
+        names = (f"{names[0]} (A)", f"{names[1]} (B)")
+    out = side(a, names[0]).merge(side(b, names[1]).drop(columns="panel"), on="claim", how="outer")
+    out["panel"] = out["panel"].fillna(out["claim"].map(dict(zip(b["claim"], b["panel"], strict=True))))
+    number = out["claim"].str.extract(r"(\d+)$")[0].astype(float)  # C2 before C10
+    out = out.assign(_order=number).sort_values(["_order", "claim"]).drop(columns="_order")
+    out = out.astype(object).where(out.notna(), "-").reset_index(drop=True)  # a claim one run lacks: '-'
+    out["moved"] = np.where(out[f"{names[0]} verdict"] == out[f"{names[1]} verdict"], "", "*")
+    return out
+

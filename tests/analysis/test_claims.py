@@ -1,0 +1,502 @@
+"""The claims (CLAIMS.md): each claim holds on tables built so that it holds and fails on tables built the other
+way round; missing tables give ``not run`` with a reason; reruns are identical; ``efish claims`` and
+``efish compare-claims`` write and print what they promise."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from efish.analysis import claims as cl
+from efish.analysis.behaviour import (
+    episode_summary,
+    food_per_agent_episode,
+    food_vs_size,
+    theil_per_episode,
+)
+from efish.analysis.claim_parts import ROW_COLUMNS, bootstrap_ci, combined_verdict, judge
+from efish.analysis.claims_report import claims_markdown, compare_claims, load_claims
+from efish.analysis.interactions import size_role_tests
+from efish.analysis.registry import SUMMARY_MEASURES, run
+from efish.analysis.signalling import fit_power_law
+from efish.analysis.stats import dunnett_by_measure, spearman
+from efish.cli import main
+
+from ..helpers import cfg_with, rollout_tables
+
+CFG = cfg_with("analysis.claims_resamples=40", "analysis.claims_fit_resamples=4")
+A, R = cl.analysis_table, cl.rollout_table
+
+
+def rng_for(name: str) -> np.random.Generator:
+    return np.random.default_rng(abs(hash(name)) % 2**32)
+
+
+# ------------------------------------------------------------ table builders
+def homing_steps(flip: bool, episodes: int = 12, steps: int = 60) -> pd.DataFrame:
+    """Homer (agent 1) steps whose error angle lies within 0.62 rad of 0 or pi and aligns over time; ``flip``: near
+    pi/2 and drifting away from alignment."""
+    rng = np.random.default_rng(2)
+    rows = []
+    for e in range(episodes):
+        t = np.arange(steps)
+        frac = t / (steps - 1)
+        if flip:
+            err = np.pi / 2 - 0.6 * (1 - frac) + rng.normal(0, 0.02, steps)
+        else:
+            mag = 0.6 * (1 - frac) + np.abs(rng.normal(0, 0.02, steps))
+            err = np.where(rng.random(steps) < 0.5, mag, np.pi - mag)
+        rows.append(pd.DataFrame({"condition": "electric", "episode": e, "agent": 1, "t": t, "err_knollen_rad": err,
+                                  "bearing_agent_rad": rng.uniform(-np.pi, np.pi, steps),
+                                  "success": t == steps - 1}))
+    return pd.concat(rows, ignore_index=True)
+
+
+def episodes_table(spec: dict[str, dict[str, float]], name: str, episodes: int = 15, agents: int = 4) -> pd.DataFrame:
+    """Agent-episodes per condition whose food, EOD probability, bites and spacing have the given means."""
+    rng = rng_for(name)
+    rows = []
+    for cond, means in spec.items():
+        for e in range(episodes):
+            for a in range(agents):
+                rows.append({"condition": cond, "episode": e, "agent": a, "size": rng.uniform(0, 1),
+                             "food_eaten": max(0, means.get("food", 5) + rng.normal(0, 0.5)),
+                             "eod_probability": np.clip(means.get("eod", 0.3) + rng.normal(0, 0.02), 0, 1),
+                             "bites_given": max(0, means.get("bites", 2) + rng.normal(0, 0.5)),
+                             "bites_received": 1, "mean_nn_dist_cm": means.get("nn", 20) + rng.normal(0, 1)})
+    return pd.DataFrame(rows)
+
+
+def behaviour_tables(assay: str, spec: dict, control: str) -> dict:
+    episodes = episodes_table(spec, assay)
+    summary = episode_summary(episodes)
+    return {A("behaviour", assay, "episode_summary"): summary,
+            A("behaviour", assay, "condition_tests"): dunnett_by_measure(summary, SUMMARY_MEASURES, "condition",
+                                                                         control)}
+
+
+def c1(flip):
+    rng = np.random.default_rng(1)
+    e, r = 1.6 + rng.normal(0, 0.1, 20), 1.05 + rng.normal(0, 0.02, 20)
+    e, r = (r, e) if flip else (e, r)
+    return {A("homing", "homing", "trajectory_shape"): pd.DataFrame({
+        "condition": ["electric"] * 20 + ["raycast"] * 20, "episode": np.r_[np.arange(20), np.arange(20)],
+        "agent": 1, "tortuosity": np.r_[e, r], "success": True})}
+
+
+def c2(flip):
+    return {R("homing", "steps"): homing_steps(flip)}
+
+
+c3 = c2
+
+
+def c4(flip):
+    rng = np.random.default_rng(4)
+    x = rng.exponential(30, 3000) + 12 if flip else (rng.pareto(1.0, 3000) + 1) * 12
+    ids = pd.DataFrame({"condition": "control", "episode": np.arange(3000) % 20, "agent": 0, "idi_ms": x})
+    fit = pd.DataFrame([{"source": "agents", "condition": "control", **fit_power_law(x, 12.0)}])
+    return {A("signalling", "wide2", "power_law"): fit, A("signalling", "wide2", "idis"): ids}
+
+
+def wide_steps(flip: bool, episodes: int = 8, steps: int = 600) -> pd.DataFrame:
+    """Two agents whose EOD rate depends on distance to agent, food and wall (``flip``: does not) and rises around
+    eating, biting and being bitten (``flip``: falls)."""
+    rng = np.random.default_rng(5)
+    rows = []
+    events = np.zeros(steps, bool)
+    events[[150, 300, 450]] = True
+    near = np.convolve(events, np.ones(21), mode="same") > 0
+    for e in range(episodes):
+        for a in range(2):
+            # distances drift slowly, so that the 20-step rolling rate sees the same distance as its step
+            d = {k: (150 if k == "agent" else 10) * (0.5 + 0.5 * np.sin(2 * np.pi * np.arange(steps) / period
+                                                                          + rng.uniform(0, 2 * np.pi)))
+                 for k, period in (("agent", 240), ("food", 170), ("wall", 130))}
+            by_distance = 0.3 if flip else 0.05 + 0.3 * (d["agent"] < 50) + 0.2 * (d["food"] < 3) + 0.2 * (d["wall"] < 3)
+            p = np.where(near, 0.02 if flip else 0.95, by_distance)
+            rows.append(pd.DataFrame({"condition": "control", "episode": e, "agent": a, "t": np.arange(steps),
+                                      "eod": rng.random(steps) < p, "ate": events, "bit": events,
+                                      "was_bitten": events, **{f"dist_{k}_cm": v for k, v in d.items()}}))
+    return pd.concat(rows, ignore_index=True)
+
+
+def c5(flip):
+    return {R("wide2", "steps"): wide_steps(flip)}
+
+
+c6 = c5
+
+
+def c7(flip):
+    rng = np.random.default_rng(7)
+    out = {}
+    for assay in ("patchy4", "square2"):
+        n = 30
+        small, big = rng.uniform(0, 0.4, n), rng.uniform(0.6, 1, n)
+        biter, bitten = (small, big) if flip else (big, small)
+        bites = pd.DataFrame({"condition": "control", "episode": np.arange(n) % 10, "biter_size": biter,
+                              "bitten_size": bitten, "size_difference": biter - bitten})
+        chases = pd.DataFrame(columns=["condition", "chaser_size", "chased_size"])
+        out[A("interactions", assay, "bite_sizes")] = bites
+        out[A("interactions", assay, "size_tests")] = size_role_tests(chases, bites)
+    size = rng.uniform(0, 1, 40)
+    out[A("behaviour", "patchy4", "win_ratio")] = pd.DataFrame({
+        "condition": "control", "episode": np.arange(40) // 4, "agent": np.arange(40) % 4, "size": size,
+        "win_ratio": np.clip((1 - size if flip else size) + rng.normal(0, 0.05, 40), 0, 1)})
+    return out
+
+
+def c8(flip):
+    rng = np.random.default_rng(8)
+    rows = []
+    for e in range(20):
+        size = rng.uniform(0, 1, 4) ** (1 + e / 5)  # episodes differ in size inequality
+        food = np.round(20 * ((1 - size) if flip else size) ** 1.5 + rng.uniform(0, 0.5, 4))
+        rows += [{"condition": "control", "episode": e, "agent": a, "size": size[a], "food_eaten": food[a]}
+                 for a in range(4)]
+    ep = pd.DataFrame(rows)
+    return {A("behaviour", "patchy4", "food_vs_size"): food_vs_size(ep),
+            A("behaviour", "patchy4", "food_per_agent"): food_per_agent_episode(ep),
+            A("behaviour", "patchy4", "theil"): theil_per_episode(ep)}
+
+
+def c9(flip):
+    rng = np.random.default_rng(9)
+    size = rng.uniform(0, 1, 40)
+    eod = pd.DataFrame({"condition": "control", "episode": np.arange(40) // 4, "agent": np.arange(40) % 4,
+                        "size": size, "eod_probability": (1 - size if flip else size) + rng.normal(0, 0.05, 40)})
+    tests = spearman(eod, "size", "eod_probability", by="condition").assign(measure="eod_probability")
+    return {A("behaviour", "patchy4", "eod_probability"): eod, A("behaviour", "patchy4", "size_tests"): tests}
+
+
+def c10(flip):
+    cut = {"food": 8 if flip else 2}  # M off and A off; the all-on control eats 5
+    k_off = {"food": 9, "eod": 0.1, "bites": 0.5, "nn": 30} if flip else {"food": 5, "eod": 0.6, "bites": 5, "nn": 10}
+    spec = {"M_A_K": {}, "A_K": cut, "M_K": cut, "M_A": k_off}
+    return {**behaviour_tables("ablation4", spec, "M_A_K"),
+            **behaviour_tables("ablation1", {k: v for k, v in spec.items() if k != "M_A"}, "M_A_K")}
+
+
+def c11(flip):
+    spec = ({"control": {}, "self_only": {"food": 9, "eod": 0.6}, "cons_only": {"food": 1, "eod": 0.1}} if flip else
+            {"control": {}, "self_only": {"food": 2, "eod": 0.1}, "cons_only": {"eod": 0.6}})
+    return behaviour_tables("collective", spec, "control")
+
+
+def c12(flip):
+    spec = {"intact": {}, "muted": {"food": 8, "nn": 10} if flip else {"food": 2, "nn": 30}}
+    return behaviour_tables("mute", spec, "intact")
+
+
+def c13(flip):
+    patchy = episode_summary(episodes_table({"control": {"food": 3 if flip else 8}}, "patchy4"))
+    uniform = episode_summary(episodes_table({"control": {"food": 5}}, "uniform4"))
+    # the same inequality in both layouts (flip: more in uniform)
+    uniform = uniform.assign(theil_t=patchy["theil_t"].to_numpy() + (1.0 if flip else 0.0))
+    spec = {f"free_{n}": {"food": 10} for n in range(1, 6)}
+    spec |= {f"iso_{n}": {"food": (12 - 2 * n) if flip else 2 * n} for n in range(1, 6)}
+    s = episode_summary(episodes_table(spec, "npatch"))
+    n = s["condition"].str[-1].astype(int)
+    iso = s["condition"].str.startswith("iso")
+    theil = np.where(iso, (6 - n if flip else n) * 0.1, 0.2) + np.random.default_rng(13).normal(0, 0.01, len(s))
+    return {A("behaviour", "patchy4", "episode_summary"): patchy, A("behaviour", "uniform4", "episode_summary"): uniform,
+            A("behaviour", "npatch", "episode_summary"): s.assign(theil_t=theil)}
+
+
+def c14(flip):
+    rng = np.random.default_rng(14)
+    b_size = {"A_gt_B": 0.25, "A_eq_B": 0.5, "A_lt_B": 0.75}
+    b_food = {"A_gt_B": 8, "A_eq_B": 6, "A_lt_B": 4} if flip else {"A_gt_B": 4, "A_eq_B": 6, "A_lt_B": 8}
+    rows = []
+    for e in range(15):
+        for cond, size in b_size.items():
+            rows += [{"condition": cond, "episode": e, "agent": 0, "size": 1 - size, "food_eaten": 5 + rng.normal()},
+                     {"condition": cond, "episode": e, "agent": 1, "size": size,
+                      "food_eaten": b_food[cond] + rng.normal(0, 0.3)}]
+        rows += [{"condition": "A_alone", "episode": e, "agent": 0, "size": 0.5, "food_eaten": 5 + rng.normal()},
+                 {"condition": "B_alone", "episode": e, "agent": 0, "size": 0.5,
+                  "food_eaten": (10 if flip else 2) + rng.normal(0, 0.3)}]
+    return {A("behaviour", "onepatch", "food_per_agent"): pd.DataFrame(rows)}
+
+
+def c15(flip):
+    reached = {("frozen", True): 9, ("frozen", False): 5, ("moving", True): 4, ("moving", False): 0}
+    rows = []
+    for rate in (0, 0.5, 1):
+        for motion in ("frozen", "moving"):
+            k = reached[(motion, rate > 0)]
+            rows.append({"condition": f"bot0.5_B0.5_rate{rate:g}_{motion}", "agent": 1, "n_episodes": 10,
+                         "n_reached": 10 - k if flip else k})
+            rows.append({"condition": f"bot0.5_B0.5_rate{rate:g}_{motion}", "agent": 0, "n_episodes": 10,
+                         "n_reached": 0})
+    return {A("onepatch", "bot", "reach_rates"): pd.DataFrame(rows)}
+
+
+def square_steps(flip: bool, episodes: int = 10, steps: int = 200) -> pd.DataFrame:
+    """Two agents 5 cm apart, confronting in the first half of each episode, agent 0 chasing 1 in the second;
+    bites mostly while confronting (``flip``: while chasing)."""
+    rng = np.random.default_rng(16)
+    rows = []
+    for e in range(episodes):
+        t = np.arange(steps)
+        confront = t < steps // 2
+        for a in range(2):
+            heading = np.where(confront, 0.0 if a == 0 else np.pi, 0.0)
+            p = np.where(confront == (not flip), 0.4, 0.02)
+            rows.append(pd.DataFrame({"condition": "control", "episode": e, "t": t, "agent": a,
+                                      "x_cm": 30.0 + 5 * a, "y_cm": 35.0, "heading_rad": heading, "size": 0.5,
+                                      "bite_target": np.where(rng.random(steps) < p, 1 - a, -1)}))
+    return pd.concat(rows, ignore_index=True)
+
+
+def c16(flip):
+    rng = np.random.default_rng(16)
+    small, big = rng.uniform(0, 0.4, 30), rng.uniform(0.6, 1, 30)
+    chaser, chased = (small, big) if flip else (big, small)
+    chases = pd.DataFrame({"condition": "control", "episode": np.arange(30) % 10, "chaser_size": chaser,
+                           "chased_size": chased, "size_difference": chaser - chased})
+    bites = pd.DataFrame(columns=["condition", "biter_size", "bitten_size"])
+    timing = pd.DataFrame({"condition": "control", "episode": np.arange(40) % 10,
+                           "phase": rng.uniform(0.7, 1, 40) if flip else rng.uniform(0, 0.3, 40)})
+    return {A("interactions", "square2", "size_tests"): size_role_tests(chases, bites),
+            A("interactions", "square2", "chase_sizes"): chases, A("interactions", "square2", "bite_timing"): timing,
+            R("square2", "steps"): square_steps(flip)}
+
+
+def c17(flip):
+    rng = np.random.default_rng(17)
+    width = CFG.train.hidden
+    patchy = pd.DataFrame({"condition": "control", "episode": np.arange(20) // 2, "agent": np.arange(20) % 2,
+                           "d_eff": (0.8 if flip else 0.1) * width + rng.normal(0, 0.5, 20)})
+    flat = rng.normal(10, 1, 10)
+    rows = []
+    for n in range(1, 5):
+        k = (10 - 2 * n if flip else 2 * n) + rng.normal(0, 0.3, 10)
+        no_k = (2 * n + rng.normal(0, 0.3, 10)) if flip else flat
+        rows += [pd.DataFrame({"condition": f"n{n}_K", "episode": np.arange(10), "agent": 0, "d_eff": k}),
+                 pd.DataFrame({"condition": f"n{n}_noK", "episode": np.arange(10), "agent": 0, "d_eff": no_k})]
+    return {A("dynamics", "patchy4", "dimensionality"): patchy,
+            A("dynamics", "groupsize", "dimensionality"): pd.concat(rows, ignore_index=True)}
+
+
+def hidden_of(steps: pd.DataFrame, columns: dict[str, np.ndarray], units: int = 6, seed: int = 0) -> pd.DataFrame:
+    """A hidden table keyed like ``steps``: the given unit columns, the other units noise."""
+    rng = np.random.default_rng(seed)
+    h = {f"h_{i}": columns.get(f"h_{i}", rng.normal(0, 1, len(steps))) for i in range(units)}
+    return steps[["condition", "episode", "agent", "t"]].assign(**h)
+
+
+def c18(flip):
+    steps = homing_steps(False)
+    rng = np.random.default_rng(18)
+    coded = steps["bearing_agent_rad" if flip else "err_knollen_rad"].to_numpy()
+    noise = rng.normal(0, 0.05, (2, len(steps)))
+    return {R("homing", "steps"): steps,
+            R("homing", "hidden"): hidden_of(steps, {"h_0": np.cos(coded) + noise[0], "h_1": np.sin(coded) + noise[1]})}
+
+
+def wide_pair(flip: bool, episodes: int = 10, steps: int = 240) -> dict:
+    """wide2 steps and hidden states: agents 5, 50 and 130 cm apart in thirds of each episode, whose hidden states
+    share a signal that fades with distance, whose power is higher far apart, whose codes favour the nearest-agent
+    distance and food in range (``flip``: all reversed)."""
+    rng = np.random.default_rng(20)
+    frames, hidden = [], []
+    gap = np.repeat([5.0, 50.0, 130.0], steps // 3)
+    share = np.repeat([0.0, 0.5, 1.0] if flip else [1.0, 0.5, 0.0], steps // 3)
+    loud = np.repeat([1.0, 1.0, 0.1] if flip else [0.1, 1.0, 1.0], steps // 3)
+    for e in range(episodes):
+        z = rng.normal(0, 1, (steps, 3))
+        for a in range(2):
+            t = np.arange(steps)
+            dist_food = rng.uniform(0, 30, steps)
+            turn = rng.normal(0, 1, steps)
+            s = pd.DataFrame({"condition": "control", "episode": e, "agent": a, "t": t,
+                              "x_cm": 15.0 + a * gap, "y_cm": 20.0, "dist_agent_cm": gap + rng.normal(0, 0.5, steps),
+                              "n_knollen_agents": (gap < 60).astype(float), "turn_rad": turn,
+                              "dist_food_cm": dist_food, "bearing_food_rad": rng.uniform(-np.pi, np.pi, steps)})
+            coded_food = (dist_food > 10) if flip else (dist_food <= 10)
+            cols = {"h_0": (turn if flip else s["dist_agent_cm"].to_numpy() / 50) + rng.normal(0, 0.05, steps),
+                    "h_1": np.where(coded_food, s["dist_food_cm"] / 10, rng.normal(0, 1, steps)),
+                    "h_2": np.where(coded_food, np.cos(s["bearing_food_rad"]), rng.normal(0, 1, steps)),
+                    "h_3": np.where(coded_food, np.sin(s["bearing_food_rad"]), rng.normal(0, 1, steps))}
+            shared = z * (share[:, None] if a else 1.0) + rng.normal(0, 0.3, (steps, 3))
+            cols |= {f"h_{4 + i}": shared[:, i] * loud for i in range(3)}
+            frames.append(s)
+            hidden.append(hidden_of(s, cols, units=7, seed=e * 2 + a))
+    s, h = pd.concat(frames, ignore_index=True), pd.concat(hidden, ignore_index=True)
+    return {R("wide2", "steps"): s, R("wide2", "hidden"): h}
+
+
+def c19(flip):
+    return wide_pair(flip)
+
+
+def c20(flip):
+    n_sig = [0, 1, 3] if flip else [3, 1, 0]
+    plsc = pd.DataFrame({"condition": "control", "lo_cm": [0.0, 10.0, 100.0], "hi_cm": [10.0, 100.0, np.inf],
+                         "n_steps": 100, "n_significant": n_sig, "s_1": 1.0, "reason": ""})
+    return {**wide_pair(flip), A("dynamics", "wide2", "plsc"): plsc}
+
+
+def c21(flip):
+    tables = wide_pair(flip)
+    rng = np.random.default_rng(21)
+    episodes = pd.DataFrame({"condition": "control", "episode": np.repeat(np.arange(10), 2),
+                             "agent": np.tile([0, 1], 10), "size": np.tile([0.3, 0.7], 10)})
+    power = np.where(episodes["agent"] == (1 if flip else 0), 2.0, 1.0) + rng.normal(0, 0.1, 20)
+    dims = episodes.drop(columns="size").assign(wideband_power=power)
+    return {**tables, R("wide2", "episodes"): episodes, A("dynamics", "wide2", "dimensionality"): dims}
+
+
+BUILDERS = {f"C{i}": f for i, f in enumerate([c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, c11, c12, c13, c14, c15,
+                                                c16, c17, c18, c19, c20, c21], start=1)}
+
+
+# -------------------------------------------------------------------- tests
+def test_every_claim_of_claims_md_is_registered_with_a_builder():
+    assert list(cl.CLAIMS) == [f"C{i}" for i in range(1, 22)] == list(BUILDERS)
+
+
+@pytest.mark.parametrize("cid", list(BUILDERS))
+def test_a_claim_holds_on_tables_built_so_and_fails_on_the_reverse(cid):
+    claim = cl.CLAIMS[cid]
+    held, failed = claim.run(BUILDERS[cid](False), CFG), claim.run(BUILDERS[cid](True), CFG)
+    assert set(held) == set(ROW_COLUMNS)
+    assert held["verdict"] == "holds", held["reason"]
+    # C5 has no direction ("varies"): without any dependence it is only weaker
+    assert failed["verdict"] == ("weaker" if cid == "C5" else "fails"), failed["reason"]
+    assert np.isfinite(held["effect"]) and held["n"] > 0
+    if np.isfinite(held["ci_low"]):
+        assert held["ci_low"] <= held["ci_high"]
+
+
+@pytest.mark.parametrize("cid", list(BUILDERS))
+def test_a_claim_without_its_tables_is_not_run_and_names_what_is_missing(cid):
+    row = cl.CLAIMS[cid].run({}, CFG)
+    assert row["verdict"] == "not run"
+    assert "has not run at this scale" in row["reason"]
+    assert any(path in row["reason"] for path in cl.CLAIMS[cid].tables)
+
+
+def test_a_missing_assay_is_named_and_the_other_parts_still_count():
+    tables = {k: v for k, v in c7(False).items() if "/square2/" not in k}
+    row = cl.CLAIMS["C7"].run(tables, CFG)
+    assert row["verdict"] == "weaker"  # two parts hold, the square2 part did not run
+    assert "analysis interactions of assay square2 has not run" in row["reason"]
+
+
+def test_degenerate_data_is_not_run_with_a_reason():
+    shape = c1(False)[A("homing", "homing", "trajectory_shape")].assign(tortuosity=np.nan)
+    row = cl.CLAIMS["C1"].run({A("homing", "homing", "trajectory_shape"): shape}, CFG)
+    assert row["verdict"] == "not run" and "tortuosity" in row["reason"]
+    path = A("behaviour", "mute", "episode_summary")
+    row = cl.CLAIMS["C12"].run({path: c12(False)[path].drop(columns="food_total")}, CFG)
+    assert row["verdict"] == "weaker" and "group food: not run" in row["reason"] and "food_total" in row["reason"]
+
+
+def test_bootstrap_reruns_are_identical_and_the_seed_matters():
+    tables = c12(False)
+    first, again = cl.CLAIMS["C12"].run(tables, CFG), cl.CLAIMS["C12"].run(tables, CFG)
+    assert first == again
+    other = cl.CLAIMS["C12"].run(tables, cfg_with("analysis.claims_resamples=40", "analysis.claims_seed=7"))
+    assert (other["ci_low"], other["ci_high"]) != (first["ci_low"], first["ci_high"])
+
+
+def test_bootstrap_resamples_whole_units_within_strata():
+    data = pd.DataFrame({"condition": ["a"] * 4 + ["b"] * 2, "episode": [0, 0, 1, 1, 0, 1],
+                         "v": [1.0, 1.0, 3.0, 3.0, 10.0, 10.0]})
+    seen = []
+
+    def stat(d):
+        seen.append(d)
+        return d.loc[d["condition"] == "a", "v"].mean()
+    lo, hi = bootstrap_ci(data, stat, ["episode"], 200, np.random.default_rng(0), strata="condition")
+    assert 1.0 <= lo <= hi <= 3.0
+    assert all((d["condition"] == "a").sum() == 4 and (d["condition"] == "b").sum() == 2 for d in seen)
+
+
+def test_verdict_rules_follow_claims_md():
+    assert judge(1.0, 0.01, +1, 0.05)[0] == "holds"
+    assert judge(1.0, 0.2, +1, 0.05)[0] == "weaker"
+    assert judge(-1.0, 0.01, +1, 0.05)[0] == "fails"
+    assert judge(-1.0, 0.2, +1, 0.05)[0] == "weaker"
+    assert judge(0.5, 0.01, 0, 0.05)[0] == "fails" and judge(0.5, 0.3, 0, 0.05)[0] == "holds"
+    assert judge(0.5, 0.01, None, 0.05)[0] == "holds" and judge(0.5, 0.3, None, 0.05)[0] == "weaker"
+    assert combined_verdict(["holds", "not run"]) == "weaker"
+    assert combined_verdict(["holds", "fails"]) == "fails"
+    assert combined_verdict(["not run", "not run"]) == "not run"
+
+
+def test_the_workflow_inputs_are_the_claim_tables_the_scale_produces():
+    smoke = {name: cfg_with("scale=smoke", f"assay={name}").assay for name in ("homing", "patchy4")}
+    produced = cl.produced_tables(smoke)
+    assert A("homing", "homing", "trajectory_shape") in produced and R("patchy4", "hidden") in produced
+    assert A("behaviour", "homing", "episode_summary") not in produced  # behaviour does not run on homing
+    needed = [t for t in cl.claim_tables() if t in produced]
+    assert needed and all(t.split("/")[1] in ("homing", "patchy4") or t.split("/")[2] in ("homing", "patchy4")
+                          for t in needed)
+
+
+# ------------------------------------------------------------------ the CLI
+@pytest.fixture(scope="module")
+def results(tmp_path_factory):
+    """A small results folder: two assays' rollout tables and their analyses, run for real."""
+    root = tmp_path_factory.mktemp("results") / "smallrun"
+    for assay in ("mute", "patchy4"):
+        cfg = cfg_with("scale=smoke", f"assay={assay}")
+        tables = rollout_tables(seed=3, conditions=tuple(cfg.assay.conditions), episodes=4, n_agents=4, steps=60)
+        for name in ("steps", "episodes"):
+            (root / "assays" / assay).mkdir(parents=True, exist_ok=True)
+            tables[name].to_parquet(root / "assays" / assay / f"{name}.parquet")
+        out = run("behaviour", tables, cfg)
+        (root / "analysis" / "behaviour" / assay).mkdir(parents=True)
+        for name, table in out.items():
+            table.to_parquet(root / "analysis" / "behaviour" / assay / f"{name}.parquet")
+    return root
+
+
+def test_efish_claims_writes_the_table_and_the_page(results, tmp_path, capsys):
+    out = tmp_path / "claims"
+    assert main(["claims", "scale=smoke", "analysis.claims_resamples=20", "analysis.claims_fit_resamples=2",
+                 "--results", str(results), "--out", str(out)]) == 0
+    table = pd.read_parquet(out / "claims.parquet")
+    assert list(table.columns) == ROW_COLUMNS and list(table["claim"]) == list(cl.CLAIMS)
+    assert set(table["verdict"]) <= {"holds", "weaker", "fails", "not run"}
+    assert table.set_index("claim").loc["C12", "verdict"] != "not run"  # mute's tables are there
+    assert table.set_index("claim").loc["C1", "verdict"] == "not run"  # homing's are not
+    page = (out / "claims.md").read_text()
+    assert page.startswith("Claims of the paper at scale smoke (run smallrun), ")
+    assert "| C12 | 4I,J |" in page and (out / "provenance.json").is_file()
+    again = tmp_path / "again"
+    main(["claims", "scale=smoke", "analysis.claims_resamples=20", "analysis.claims_fit_resamples=2",
+          "--results", str(results), "--out", str(again)])
+    pd.testing.assert_frame_equal(table, pd.read_parquet(again / "claims.parquet"))
+
+
+def test_compare_claims_prints_both_runs_side_by_side(results, tmp_path, capsys):
+    a = pd.DataFrame([cl.CLAIMS["C12"].run(c12(False), CFG), cl.CLAIMS["C9"].run(c9(False), CFG)])
+    b = pd.DataFrame([cl.CLAIMS["C12"].run(c12(True), CFG)])
+    (tmp_path / "runa" / "claims").mkdir(parents=True)
+    (tmp_path / "runb").mkdir()
+    a.to_parquet(tmp_path / "runa" / "claims" / "claims.parquet")
+    b.to_parquet(tmp_path / "runb" / "claims.parquet")
+    assert main(["compare-claims", str(tmp_path / "runa" / "claims"), str(tmp_path / "runb" / "claims.parquet")]) == 0
+    text = capsys.readouterr().out
+    assert "runa verdict" in text and "runb verdict" in text
+    lines = {line.split()[0]: line for line in text.splitlines()[1:]}
+    assert list(lines) == ["C9", "C12"]
+    assert "holds" in lines["C12"] and "fails" in lines["C12"] and lines["C12"].rstrip().endswith("*")
+    assert main(["compare-claims", str(tmp_path / "nowhere"), str(tmp_path / "runb")]) == 2
+    assert "no claims table" in capsys.readouterr().err
+
+
+def test_load_claims_resolves_a_run_name(tmp_path):
+    t = pd.DataFrame([cl.CLAIMS["C9"].run(c9(False), CFG)])
+    (tmp_path / "results" / "myrun" / "claims").mkdir(parents=True)
+    t.to_parquet(tmp_path / "results" / "myrun" / "claims" / "claims.parquet")
+    name, table = load_claims("myrun", tmp_path / "results")
+    assert name == "myrun" and table["claim"].tolist() == ["C9"]
+    both = compare_claims(table, table, (name, name))
+    assert both.loc[0, "moved"] == "" and claims_markdown(table, "header").startswith("header\n")
