@@ -1,7 +1,256 @@
-"""Fig 6: hidden-state dynamics: dimensionality, decoding, PLSC between agents and wideband power (SPEC 13)."""
+"""Fig 6: hidden-state dynamics: dimensionality, decoding, PLSC between agents and wideband power (SPEC 13).
+
+Panels read the dynamics analysis (``analysis/dynamics/<assay>/``):
+``dimensionality`` (D_eff, PCs for the variance fraction and wideband power
+per agent-episode), ``subsampling`` (D_eff of random unit subsets),
+``decoding`` (cross-validated score per target) and ``plsc`` (per distance
+bin). Where the analysis does not yet write what a panel needs (the PCA
+variance spectrum, decoding split by food distance, power split by the
+conspecific's distance, the trend and pair tests), the panel draws what there
+is and its caption, or the panel itself, says what is missing.
+"""
 
 from __future__ import annotations
 
-from .panel import Panel
+import re
 
-PANELS: list[Panel] = []
+import numpy as np
+import pandas as pd
+
+from ..config.schema import AnalysisConfig
+from .fig4 import condition_order
+from .panel import Panel, Tables
+from .style import (
+    NEUTRAL_COLOUR,
+    RECEPTOR_COLOURS,
+    box_strip,
+    condition_palette,
+    group_size_colours,
+    mean_lines,
+    missing,
+    size_class_colours,
+)
+
+#: The groupsize assay's condition names: ``n<N>_K`` (Knollenorgans on) and ``n<N>_noK`` (off).
+GROUPSIZE_CONDITION = re.compile(r"^n(\d+)_(K|noK)$")
+KNOLLENORGAN_STATE = {"K": "K on", "noK": "K off"}
+KNOLLENORGAN_COLOURS = {"K on": RECEPTOR_COLOURS["knollenorgan"], "K off": NEUTRAL_COLOUR}
+KNOLLENORGAN_STYLES = {"K on": "-", "K off": "--"}
+#: Readable names of the decoding targets (steps columns, efish.analysis.dynamics.DECODE_TARGETS).
+TARGET_LABELS = {
+    "dist_agent_cm": "nearest agent: distance", "bearing_agent_rad": "nearest agent: bearing",
+    "dist_agent2_cm": "2nd agent: distance", "size_agent1": "nearest agent: size",
+    "size_agent2": "2nd agent: size", "n_knollen_agents": "agents heard (K)",
+    "dist_food_cm": "food: distance", "bearing_food_rad": "food: bearing", "food_count_5cm": "pellets within 5 cm",
+    "dist_wall_cm": "wall: distance", "bearing_wall_rad": "wall: bearing", "size": "own size", "eod": "own EOD",
+    "turn_rad": "turn", "log_morm_field": "log field (M)", "log_amp_field": "log field (A)",
+}
+POWER_LABEL = "wideband power (1/Hz)"
+
+
+def dimensionality_box(tables: Tables, ax) -> None:
+    """Panel A: D_eff and the number of PCs reaching the variance fraction, per agent-episode of patchy4."""
+    dims = tables["dims"]
+    share = AnalysisConfig().variance_fraction
+    names = {"d_eff": "D_eff", "pcs_for_variance": f"PCs for {share:.0%} var."}
+    long = dims.melt(id_vars=[c for c in dims.columns if c not in names], value_vars=list(names),
+                     var_name="measure", value_name="dimensions")
+    order = list(names)
+    if box_strip(ax, long, "measure", "dimensions", order, condition_palette(order), labels=names):
+        ax.set_xlabel("per agent-episode (patchy4)")
+        ax.set_ylabel("dimensions of the hidden state")
+        ax.set_title("Hidden-state dimensionality")
+
+
+def groupsize_frame(table: pd.DataFrame) -> pd.DataFrame:
+    """A groupsize table with ``n_agents`` and ``knollenorgans`` (K on / K off) parsed from the condition."""
+    parts = table["condition"].astype(str).str.extract(GROUPSIZE_CONDITION)
+    if parts.isna().all(axis=None):
+        raise ValueError(f"no groupsize condition is named n<N>_K or n<N>_noK: "
+                         f"{sorted(table['condition'].dropna().unique())}")
+    return table.assign(n_agents=pd.to_numeric(parts[0]), knollenorgans=parts[1].map(KNOLLENORGAN_STATE)) \
+        .dropna(subset=["knollenorgans"])
+
+
+def deff_vs_group_size(tables: Tables, ax) -> None:
+    """Panel B: D_eff per agent-episode against group size, Knollenorgans on and off (mean +- SEM)."""
+    frame = groupsize_frame(tables["dims"])
+    if mean_lines(ax, frame, "n_agents", "d_eff", "knollenorgans", KNOLLENORGAN_COLOURS, KNOLLENORGAN_STYLES):
+        ax.set_xlabel("group size N (agents)")
+        ax.set_ylabel("D_eff of the hidden state")
+        ax.set_title("Dimensionality vs group size")
+        ax.legend(loc="best")
+
+
+def subsampling_curves(tables: Tables, ax) -> None:
+    """Panel C: mean D_eff of random unit subsets against the fraction of units kept, per group size and K."""
+    frame = groupsize_frame(tables["subsampling"]).dropna(subset=["d_eff"])
+    if frame.empty:
+        missing(ax, "no finite D_eff in the groupsize subsampling table")
+        return
+    means = frame.groupby(["n_agents", "knollenorgans", "fraction"])["d_eff"].mean().reset_index()
+    colours = group_size_colours(means["n_agents"])
+    for (n, k), sub in means.groupby(["n_agents", "knollenorgans"]):
+        ax.plot(sub["fraction"], sub["d_eff"], color=colours[int(n)], ls=KNOLLENORGAN_STYLES[k], marker="o", ms=2.5,
+                label=f"N = {int(n)}" if k == "K on" else None)
+    ax.plot([], [], color=NEUTRAL_COLOUR, ls=KNOLLENORGAN_STYLES["K off"], label="K off")
+    ax.set_xlabel("fraction of hidden units kept")
+    ax.set_ylabel("D_eff (mean over draws)")
+    ax.set_title("Unit subsampling")
+    ax.legend(loc="upper left", fontsize=6, ncols=1)
+
+
+def decoding_bars(assay: str, title: str):
+    """A draw function: decoding score per target (sorted, best on top), one bar colour per condition."""
+    def draw(tables: Tables, ax) -> None:
+        import seaborn as sns
+
+        decoding = tables["decoding"]
+        scored = decoding[np.isfinite(pd.to_numeric(decoding["score"], errors="coerce"))]
+        if scored.empty:
+            reasons = [r for r in decoding["reason"].astype(str) if r and r != "nan"]
+            missing(ax, f"no decoding score in {assay}: {reasons[0] if reasons else 'empty table'}")
+            return
+        scored = scored.assign(label=scored["target"].map(lambda t: TARGET_LABELS.get(t, t)))
+        ranking = scored.groupby("label")["score"].mean().sort_values(ascending=False).index.tolist()
+        conditions = condition_order(assay, scored["condition"])
+        sns.barplot(data=scored, x="score", y="label", hue="condition", order=ranking, hue_order=conditions,
+                    palette=condition_palette(conditions), orient="h", legend=len(conditions) > 1, ax=ax)
+        ax.axvline(0.0, color="black", lw=0.5)
+        ax.set_xlabel("decoding score (R$^2$ - baseline R$^2$)")
+        ax.set_ylabel("decoded variable")
+        ax.tick_params(axis="y", labelsize=6)
+        ax.set_title(title)
+        if len(conditions) > 1:
+            ax.legend(loc="best", fontsize=6)
+
+    return draw
+
+
+def needs_analysis(what: str):
+    """A draw function for a panel whose data the dynamics analysis does not write yet: it says which."""
+    def draw(tables: Tables, ax) -> None:
+        missing(ax, what)
+        ax.set_xlabel("")
+        ax.set_ylabel("")
+
+    return draw
+
+
+def bin_label(lo: float, hi: float) -> str:
+    """Tick label of a PLSC distance bin (lo, hi] in cm."""
+    if lo <= 0:
+        return f"<= {hi:g}"
+    return f"> {lo:g}" if not np.isfinite(hi) else f"{lo:g}-{hi:g}"
+
+
+def plsc_bars(column: str, ylabel: str, title: str, integer: bool = False):
+    """A draw function: one PLSC value per pair-distance bin of wide2 (agents 0 and 1); an empty bin says why.
+
+    ``integer`` puts the y ticks on whole numbers (counts of dimensions)."""
+    def draw(tables: Tables, ax) -> None:
+        plsc = tables["plsc"]
+        if "lo_cm" not in plsc or plsc["lo_cm"].isna().all():
+            missing(ax, f"plsc table has no distance bins: {plsc['reason'].iloc[0] if len(plsc) else 'empty'}")
+            return
+        conditions = condition_order("wide2", plsc["condition"].dropna())
+        palette = condition_palette(conditions)
+        bins = plsc[["lo_cm", "hi_cm"]].drop_duplicates().sort_values("lo_cm").to_numpy()
+        width = 0.8 / len(conditions)
+        for j, cond in enumerate(conditions):
+            rows = plsc[plsc["condition"] == cond].set_index(["lo_cm", "hi_cm"])
+            for i, (lo, hi) in enumerate(bins):
+                x = i + (j - (len(conditions) - 1) / 2) * width
+                row = rows.loc[(lo, hi)] if (lo, hi) in rows.index else None
+                value = float(row[column]) if row is not None else np.nan
+                if np.isfinite(value):  # the value on the bar, so that a zero is seen as a zero
+                    ax.bar(x, value, width * 0.9, color=palette[cond], label=cond if i == 0 else None)
+                    ax.text(x, value, f"{value:.3g}", ha="center", va="bottom", fontsize=6)
+                else:  # a bin with too few steps: say so where its bar would be
+                    ax.text(x, 0.02, "n/a", ha="center", va="bottom", fontsize=6, color=NEUTRAL_COLOUR,
+                            transform=ax.get_xaxis_transform())
+        ax.set_xticks(range(len(bins)), [bin_label(lo, hi) for lo, hi in bins])
+        ax.set_xlim(-0.6, len(bins) - 0.4)
+        if integer:
+            from matplotlib.ticker import MaxNLocator
+
+            ax.yaxis.set_major_locator(MaxNLocator(integer=True))
+        ax.set_xlabel("distance between the two agents (cm)")
+        ax.set_ylabel(ylabel)
+        ax.set_title(title)
+        if len(conditions) > 1:
+            ax.legend(loc="best")
+
+    return draw
+
+
+def power_by_size(tables: Tables, ax) -> None:
+    """Panel J: wideband power of the agent below vs above its episode's median size (equal sizes dropped)."""
+    dims, episodes = tables["dims"], tables["episodes"]
+    keys = ["condition", "episode", "agent"]
+    frame = dims.merge(episodes[[*keys, "size"]], on=keys, how="left")
+    median = frame.groupby(["condition", "episode"])["size"].transform("median")
+    frame = frame.assign(size_class=np.select([frame["size"] < median, frame["size"] > median],
+                                              ["smaller", "larger"], ""))
+    order = ["smaller", "larger"]
+    if box_strip(ax, frame, "size_class", "wideband_power", order, dict(zip(order, size_class_colours(2),
+                                                                             strict=True))):
+        ax.set_xlabel("agent within its episode (wide2)")
+        ax.set_ylabel(POWER_LABEL)
+        ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 3))
+        ax.set_title("Power vs size")
+
+
+def _dyn(assay: str, table: str) -> str:
+    return f"analysis/dynamics/{assay}/{table}.parquet"
+
+
+PANELS = [
+    Panel("fig6", "A", dimensionality_box, {"dims": _dyn("patchy4", "dimensionality")},
+          "Dimensionality of the hidden state per agent-episode of the patchy4 assay: D_eff (1 / sum of squared "
+          "normalised PCA variances) and the number of PCs reaching analysis.variance_fraction of the variance, "
+          "from analysis/dynamics/patchy4/dimensionality. The cumulative-variance curve itself needs the PCA "
+          "variance spectrum, which no analysis table holds yet."),
+    Panel("fig6", "B", deff_vs_group_size, {"dims": _dyn("groupsize", "dimensionality")},
+          "D_eff of the hidden state per agent-episode against group size N, Knollenorgans on (solid) and off "
+          "(dashed), mean +- SEM, groupsize assay, analysis/dynamics/groupsize/dimensionality. No trend test: the "
+          "Spearman of D_eff against N per Knollenorgan state is not in any analysis table."),
+    Panel("fig6", "C", subsampling_curves, {"subsampling": _dyn("groupsize", "subsampling")},
+          "D_eff of random subsets of hidden units (analysis.subsample_fractions of the units, "
+          "analysis.subsample_draws draws each) against the fraction kept, mean over draws and agent-episodes, per "
+          "group size (colour) and Knollenorgan state (dashed: off), groupsize assay, "
+          "analysis/dynamics/groupsize/subsampling."),
+    Panel("fig6", "D", decoding_bars("homing", "Homing: decoding"), {"decoding": _dyn("homing", "decoding")},
+          "Cross-validated linear decoding of step variables from the homer's hidden state (score = held-out R^2 "
+          "minus that of the training mean; folds grouped by episode), electric and ray-casting homing policies, "
+          "analysis/dynamics/homing/decoding; targets without a score (e.g. no food in the arena) are left out. "
+          "The Knollenorgan error angle is not a decoding target of the analysis yet."),
+    Panel("fig6", "E", decoding_bars("wide2", "Two agents: decoding"), {"decoding": _dyn("wide2", "decoding")},
+          "Decoding score per step variable from the hidden state of both agents of the wide2 assay (160 x 40 cm), "
+          "ranked best first, analysis/dynamics/wide2/decoding; targets without a score are left out."),
+    Panel("fig6", "F", needs_analysis("no food-near / food-far split\nin analysis/dynamics/wide2/decoding"),
+          {"decoding": _dyn("wide2", "decoding")},
+          "Food variables decoded when food is near vs far (wide2): the dynamics analysis does not split decoding "
+          "by food distance yet, so the panel says so instead of drawing."),
+    Panel("fig6", "G", plsc_bars("s_1", "first PLSC singular value", "PLSC: first component"),
+          {"plsc": _dyn("wide2", "plsc")},
+          "Partial least squares correlation of the two wide2 agents' z-scored hidden states per pair-distance bin "
+          "(analysis.plsc_edges_cm): the first singular value of their cross-covariance, "
+          "analysis/dynamics/wide2/plsc. The first component's score correlation and its Spearman against "
+          "distance are not in the table yet."),
+    Panel("fig6", "H", plsc_bars("n_significant", "significant PLSC dimensions", "PLSC: shared dimensions", integer=True),
+          {"plsc": _dyn("wide2", "plsc")},
+          "Number of PLSC components whose singular value and score correlation both exceed the "
+          "analysis.plsc_percentile of a circular-shift null (counted until the first failure), per pair-distance "
+          "bin of the wide2 assay, analysis/dynamics/wide2/plsc."),
+    Panel("fig6", "I", needs_analysis("no near / far split of wideband power\nin analysis/dynamics/wide2"),
+          {"dims": _dyn("wide2", "dimensionality")},
+          "Wideband power with the conspecific near vs far (wide2): the dynamics analysis computes power per "
+          "agent-episode only, not per distance, so the panel says so instead of drawing."),
+    Panel("fig6", "J", power_by_size, {"dims": _dyn("wide2", "dimensionality"),
+                                       "episodes": "assays/wide2/episodes.parquet"},
+          "Wideband power of the hidden state (spectrogram, analysis.spectrogram_window-step windows) per "
+          "agent-episode of the wide2 assay, the smaller vs the larger agent of each episode (sizes from the "
+          "episodes table), analysis/dynamics/wide2/dimensionality. No stars: the Mann-Whitney test of smaller vs "
+          "larger is not in any analysis table."),
+]

@@ -1,0 +1,100 @@
+"""Fig 6 panels: every panel renders from real-shaped tables, drawn values are the tables' own, gaps are said."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from efish.figures import fig6
+from efish.figures.registry import PANELS
+from efish.figures.render import load_tables, render_panel
+from efish.figures.style import panel_style
+
+FIG6 = [key for key in PANELS if key.startswith("fig6/")]
+#: Panels whose data no analysis table holds yet: they say so on themselves.
+NOT_ANALYSED = {"fig6/F", "fig6/I"}
+
+
+def draw(key: str, tables: dict):
+    """Draw panel ``key`` from ``tables`` on a fresh axes; returns the axes (its figure closed, still readable)."""
+    with panel_style() as plt:
+        fig = plt.figure()
+        ax = fig.add_subplot()
+        PANELS[key].draw(tables, ax)
+        plt.close(fig)
+    return ax
+
+
+def texts(ax) -> list[str]:
+    return [t.get_text() for t in ax.texts]
+
+
+def test_every_letter_of_spec_13_is_registered():
+    assert sorted(k.split("/")[1] for k in FIG6) == list("ABCDEFGHIJ")
+
+
+@pytest.mark.parametrize("key", FIG6)
+def test_every_panel_renders_with_labelled_axes(key, synthetic_results, tmp_path):
+    written = render_panel(key, synthetic_results, tmp_path, seeds=2)
+    assert all(p.stat().st_size > 1000 for p in written)
+    ax = draw(key, load_tables(PANELS[key], synthetic_results, seeds=2))
+    said_missing = any(t.startswith("no data") for t in texts(ax))
+    assert said_missing == (key in NOT_ANALYSED), key
+    assert said_missing or (ax.get_xlabel() and ax.get_ylabel()), key
+
+
+def test_decoding_bars_are_the_scores_best_first_without_unscored_targets():
+    table = pd.DataFrame({"condition": "control", "target": ["eod", "dist_agent_cm", "size", "dist_food_cm"],
+                          "score": [0.2, 0.6, np.nan, -0.1], "reason": ["", "", "constant target", ""]})
+    ax = draw("fig6/E", {"decoding": table})
+    widths = [p.get_width() for p in ax.patches if p.get_height() > 0]
+    np.testing.assert_allclose(widths, [0.6, 0.2, -0.1])
+    assert [t.get_text() for t in ax.get_yticklabels()] == ["nearest agent: distance", "own EOD", "food: distance"]
+
+
+def test_decoding_without_any_score_says_why():
+    table = pd.DataFrame({"condition": ["electric"], "target": ["size"], "score": [np.nan],
+                          "reason": ["constant target"]})
+    ax = draw("fig6/D", {"decoding": table})
+    assert any("constant target" in t for t in texts(ax))
+
+
+def test_plsc_bars_are_the_table_values_and_an_empty_bin_says_n_a():
+    table = pd.DataFrame({"lo_cm": [0.0, 10.0, 100.0], "hi_cm": [10.0, 100.0, np.inf], "n_steps": [3, 50, 40],
+                          "n_significant": [np.nan, 3.0, 0.0], "s_1": [np.nan, 2.5, 1.0],
+                          "reason": ["need T >= 10", "", ""], "condition": "control"})
+    ax = draw("fig6/H", {"plsc": table})
+    np.testing.assert_allclose([p.get_height() for p in ax.patches], [3.0, 0.0])
+    assert sorted(texts(ax)) == ["0", "3", "n/a"]
+    assert [t.get_text() for t in ax.get_xticklabels()] == ["<= 10", "10-100", "> 100"]
+
+
+def test_power_by_size_puts_each_agent_in_its_size_class_and_drops_equal_sizes():
+    dims = pd.DataFrame({"condition": "control", "episode": [0, 0, 1, 1, 2, 2], "agent": [0, 1] * 3,
+                         "wideband_power": [1.0, 2.0, 4.0, 3.0, 9.0, 9.5], "reason": ""})
+    episodes = pd.DataFrame({"condition": "control", "episode": [0, 0, 1, 1, 2, 2], "agent": [0, 1] * 3,
+                             "size": [0.2, 0.8, 0.9, 0.1, 0.5, 0.5]})
+    ax = draw("fig6/J", {"dims": dims, "episodes": episodes})
+    by_x = {}
+    for c in ax.collections:
+        for x, y in c.get_offsets():
+            by_x.setdefault(round(x), []).append(y)
+    assert sorted(by_x[0]) == [1.0, 3.0] and sorted(by_x[1]) == [2.0, 4.0]
+
+
+def test_group_size_and_knollenorgans_come_from_the_condition_names():
+    frame = fig6.groupsize_frame(pd.DataFrame({"condition": ["n1_K", "n3_noK", "other"], "d_eff": [1.0, 2.0, 3.0]}))
+    assert frame["n_agents"].tolist() == [1, 3]
+    assert frame["knollenorgans"].tolist() == ["K on", "K off"]
+    with pytest.raises(ValueError, match="n<N>_K or n<N>_noK"):
+        fig6.groupsize_frame(pd.DataFrame({"condition": ["control"]}))
+
+
+def test_deff_vs_group_size_means_per_knollenorgan_state():
+    dims = pd.DataFrame({"condition": ["n1_K", "n1_K", "n2_K", "n1_noK", "n2_noK"], "d_eff": [2.0, 4.0, 5.0, 1.0, 1.5],
+                         "reason": ""})
+    ax = draw("fig6/B", {"dims": dims})
+    means = {c.get_label(): c.lines[0].get_ydata() for c in ax.containers}
+    np.testing.assert_allclose(means["K on"], [3.0, 5.0])
+    np.testing.assert_allclose(means["K off"], [1.0, 1.5])
