@@ -21,6 +21,8 @@
     efish bench env [overrides] [--json]      env-only throughput, fast vs reference physics
     efish bench train [overrides] [--json]    rollout/update speed, model-FLOP utilisation
     efish bench pipeline [--results D]        time per rule family of a pipeline run (Snakemake benchmarks)
+    efish plan-cluster [overrides]            every job of a scale (scale=paper) with runtime, memory, cores, vs the
+                                              slurm profile (from the laptop run's benchmark files)
 
 Overrides are Hydra's ``key=value`` (``physics.image_order=2``) or group
 choices (``arena=patchy70``). Every error is one line on stderr, exit code 2,
@@ -109,6 +111,15 @@ def _parser() -> argparse.ArgumentParser:
     cc.add_argument("a", help="claims.parquet, a claims folder, or a run name (results/<name>/claims/claims.parquet)")
     cc.add_argument("b", help="the same for the second run")
     cc.set_defaults(overrides=[])
+    pc = sub.add_parser("plan-cluster", help="expected runtime, memory and cores of every job of a scale, checked "
+                                             "against a SLURM profile")
+    pc.add_argument("overrides", nargs="*", help="the scale to plan and its overrides, e.g. scale=paper")
+    pc.add_argument("--from", dest="source", default="laptop", help="scale whose run was measured (default laptop)")
+    pc.add_argument("--results", type=Path, help="results folder of that run (default results/<--from>)")
+    pc.add_argument("--profile", type=Path, default=Path("workflow/profiles/slurm"), help="profile to check")
+    pc.add_argument("--dry-run", type=Path, help="a saved `snakemake -n --forceall` output instead of running it")
+    pc.add_argument("--json", action="store_true", help="print JSON records instead of a table")
+    pc.add_argument("--suggest", action="store_true", help="also print set-resources covering the headroom")
     b = sub.add_parser("bench", help="speed and accuracy studies")
     bsub = b.add_subparsers(dest="bench", required=True)
     bp = bsub.add_parser("physics", help="sensing throughput: fast path vs reference, one thread")
@@ -383,6 +394,19 @@ def _accuracy_figure(results: Path, out: Path) -> list[Path]:
     return written
 
 
+def _plan_cluster(args) -> None:
+    from .bench.cluster import format_plan, plan_cluster, suggested_resources
+
+    text = args.dry_run.read_text() if args.dry_run else None
+    checked = plan_cluster(args.overrides, args.source, args.results or Path("results") / args.source, args.profile,
+                           text)
+    print(checked.to_json(orient="records", indent=1) if args.json else format_plan(checked))
+    if args.suggest:
+        import yaml
+
+        print(yaml.safe_dump({"set-resources": suggested_resources(checked)}, sort_keys=True), end="")
+
+
 def _bench_physics(args, cfg, started) -> None:
     from .bench.physics import bench_physics, format_physics
     from .io import write_text_atomic
@@ -465,6 +489,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             _compare_claims(args)
         elif args.command == "scene":
             _scene(args, cfg, started)
+        elif args.command == "plan-cluster":
+            _plan_cluster(args)
         elif args.command == "plan":
             from .env.vec_env import scene_of
             from .physics.plan import build_plan

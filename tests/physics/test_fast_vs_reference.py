@@ -218,3 +218,42 @@ def test_self_and_cons_parts_add_up_to_the_induced_field_of_all_emitters(gate_sc
     np.testing.assert_allclose(muted.morm_self[0, 0], both.morm_self[0, 0], rtol=1e-12)
     assert np.all(muted.morm_cons[0, 0] == 0.0)  # the only other emitter is muted
     assert not np.allclose(muted.morm_cons[0, 2], both.morm_cons[0, 2])
+
+
+LARGE_SCENES = [pytest.param(("arena.width_cm=560", "arena.height_cm=560"), id="560x560"),
+                pytest.param(("arena.width_cm=280", "arena.height_cm=280", "env.n_agents=8", "env.obs_agents=8"),
+                             id="280x280-8agents"),
+                pytest.param(("arena.food_multiplier=10",), id="70x70-crowded-x10")]
+
+
+@functools.lru_cache(maxsize=None)
+def large_scene(overrides: tuple[str, ...]):
+    """Two patchy snapshots (one as at reset, one foraging) of a large or crowded arena and their reference."""
+    from efish.bench.scenes import benchmark_batch
+    from efish.physics.plan import build_plan
+
+    cfg = cfg_with(*overrides)
+    batch = benchmark_batch(cfg, 2, 3)
+    exact_plan = build_plan(cfg, tolerance=0.0)
+    ref_raw = reference_raw(batch, exact_plan)
+    return cfg, batch, ref_raw, normalise(ref_raw, batch.agent_size, exact_plan)
+
+
+@pytest.mark.parametrize("overrides", LARGE_SCENES)
+def test_large_and_crowded_scenes_match_reference(overrides):
+    """Thousands of pellets (560 x 560: about 5,500, x5 with their images) or ten times the food of 70 x 70:
+    tolerance 0 equals the reference to rounding, the default tolerance stays within 1e-6."""
+    from efish.physics.plan import build_plan
+
+    cfg, batch, ref_raw, ref = large_scene(overrides)
+    assert batch.pellet_alive.sum(axis=1).min() >= 500  # really a crowded scene
+    exact_raw = fast_raw(batch, build_plan(cfg, tolerance=0.0))
+    for name in ("mormyromast", "ampullary"):
+        assert np.any(ref[name] != 0), name  # not a vacuous comparison
+        np.testing.assert_allclose(getattr(exact_raw, name), getattr(ref_raw, name), rtol=1e-9,
+                                   atol=1e-6 * e_min((), name), err_msg=name)
+    plan = build_plan(cfg)
+    got = normalise(fast_raw(batch, plan), batch.agent_size, plan)
+    for name in ("mormyromast", "ampullary"):
+        assert max_norm_diff(got, ref, name) <= 1e-6, name
+    np.testing.assert_array_equal(got["knollenorgan"], ref["knollenorgan"])

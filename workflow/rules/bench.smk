@@ -58,3 +58,26 @@ rule figure_bench_accuracy:
     shell:
         "efish figure bench/accuracy {params.overrides} --results results/{wildcards.run} --out {params.out} "
         "> {log} 2>&1"
+
+
+rule bench_scaling:
+    output:
+        table="results/{run}/bench/bench_scaling.parquet",
+        png=report(
+            "results/{run}/bench/bench_scaling.png",
+            caption="../report/bench_scaling.rst",
+            category="Benchmarks",
+        ),
+        pdf="results/{run}/bench/bench_scaling.pdf",
+    log:
+        "results/{run}/logs/bench_scaling.log",
+    benchmark:
+        "results/{run}/benchmarks/bench_scaling.tsv"
+    params:
+        overrides=ARGS,
+        out=folder_of("table"),
+    threads: 1
+    conda:
+        "../envs/efish.yaml"
+    shell:
+        "efish bench scaling {params.overrides} --out {params.out} > {log} 2>&1"

@@ -175,6 +175,9 @@ def all_targets():
         f"results/{RUN}/bench/bench_accuracy.parquet",
         f"figures/{RUN}/bench/bench_accuracy.png",
         f"figures/{RUN}/bench/bench_accuracy.pdf",
+        f"results/{RUN}/bench/bench_scaling.parquet",
+        f"results/{RUN}/bench/bench_scaling.png",
+        f"results/{RUN}/bench/bench_scaling.pdf",
     ]
     targets += [f"results/{RUN}/assays/{a}/{t}.parquet" for a in ASSAYS for t in ("steps", "episodes", "food")]
     targets += [f"results/{RUN}/assays/{a}/hidden.parquet" for a in HIDDEN_ASSAYS]

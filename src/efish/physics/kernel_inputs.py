@@ -68,6 +68,7 @@ class Outputs(NamedTuple):
     mormyromast: np.ndarray   # DT[B, N, S_m]
     ampullary: np.ndarray     # DT[B, N, S_a]
     knollenorgan: np.ndarray  # DT[B, N, N - 1, S_k]  slot j: the j-th other agent in id order
+    error_bound: np.ndarray   # float64[B, N, 2]  bound of |raw - exact| per Mormyromast, Ampullary reading (V/m)
 
 
 class Arena(NamedTuple):
@@ -130,6 +131,8 @@ class SourceList(NamedTuple):
     shared: bool       # shared mode: Mormyromast moments are an agent weight times T1
     bound_m: float     # bound sums of the shared sources, Mormyromast column (0 unless ``shared``)
     bound_a: float     # the same, Ampullary column
+    error_m: float     # error bound of the shared sources' interpolation at any agent, Mormyromast column
+    error_a: float     # the same, Ampullary column
 
 
 class Workspace(NamedTuple):

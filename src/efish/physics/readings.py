@@ -19,6 +19,8 @@ class RawReadings:
     ampullary: float[B, N, 24]
     knollenorgan: float[B, N, N-1, 12]  # slot j = j-th other agent in id order
     morm_self, morm_cons: float[B, N, 36] or None  # ungated parts (reference only)
+    error_bound: float64[B, N, 2] or None  # fast path: bound of |reading - exact| of every Mormyromast
+        # (column 0) and Ampullary (1) reading of an agent, V/m (0 at tolerance 0: exact to round-off)
     """
 
     mormyromast: np.ndarray
@@ -26,6 +28,24 @@ class RawReadings:
     knollenorgan: np.ndarray
     morm_self: np.ndarray | None = None
     morm_cons: np.ndarray | None = None
+    error_bound: np.ndarray | None = None
+
+
+def normalised_error_bound(raw: RawReadings, plan: EffectPlan) -> np.ndarray:
+    """float64[B, N, 2]: bound of the error of every normalised Mormyromast (0) and Ampullary (1) reading.
+
+    The normalisation (SPEC 3.4) after a noise factor u is Lipschitz in the raw reading
+    with constant u / (E_min ln 10 (log10 E_max - log10 E_min)): it is flat below E_min
+    and above E_max, logarithmic between. So a raw error bound times that constant, at the
+    largest factor noise can draw, bounds the normalised error with or without noise.
+    """
+    if raw.error_bound is None:
+        raise ValueError("these readings carry no error bound (the reference is exact; use the fast path)")
+    def lipschitz(lo: float, hi: float, noise: float) -> float:
+        return noise / (lo * np.log(10) * np.log10(hi / lo))
+
+    scale = np.array([lipschitz(*plan.morm_range, plan.max_noise), lipschitz(*plan.amp_range, plan.max_amp_noise)])
+    return raw.error_bound * scale
 
 
 def empty_readings(b: int, n: int, plan: EffectPlan, dtype=np.float64) -> RawReadings:

@@ -221,8 +221,10 @@ def interpolate_add(out, matrix, values, lo, hi):
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def sense_agent(a, arena, srcs, plan, stage, out_m, out_a):
-    """Mormyromast (out_m, DT[S_m]) and Ampullary (out_a, DT[S_a]) raw readings of agent ``a`` of ``arena``.
+def sense_agent(a, arena, srcs, plan, stage, out_m, out_a, out_err):
+    """Mormyromast (out_m, DT[S_m]) and Ampullary (out_a, DT[S_a]) raw readings of agent ``a`` of ``arena``,
+    and in ``out_err`` (float64[2]) a bound of their error per reading: the bounds of every culled source
+    plus the interpolation error bounds (the whole bound sum for a class skipped as exactly zero).
 
     ``srcs`` lists the sources that are not shared, with ``a``'s Mormyromast
     moments in ``stage.geo``; :func:`~efish.physics.sources.gather_sources`
@@ -238,12 +240,17 @@ def sense_agent(a, arena, srcs, plan, stage, out_m, out_a):
     ax, ay, heading = arena.axy[a, 0], arena.axy[a, 1], arena.heading[a]
     thr1 = c[TOL_MORM] if flags[CULL] else -1.0
     thr2 = c[TOL_AMP] if flags[CULL] else -1.0
-    n_dense, tot1, tot2 = gather_sources(a, ax, ay, thr1, thr2, srcs, c, plan.level_lcq, plan.level_e, stage)
-    tot1 += srcs.bound_m  # plus the shared sources' bounds
+    n_dense, tot1, tot2, err1, err2 = gather_sources(a, ax, ay, thr1, thr2, srcs, c, plan.level_lcq, plan.level_e,
+                                                     stage)
+    tot1 += srcs.bound_m  # plus the shared sources' bounds and errors
     tot2 += srcs.bound_a
+    err1 += srcs.error_m
+    err2 += srcs.error_a
     walls = flags[DO_WALLDIST] and arena.emitting[a] and arena.img.shape[0] > 1 and c[G_SELF] != 0
     do_m = flags[DO_MORM] and (walls or not flags[CULL] or tot1 > c[ZERO_MORM])
     do_a = flags[DO_AMP] and (not flags[CULL] or tot2 > c[ZERO_AMP])
+    out_err[0] = (err1 if do_m else tot1) if flags[DO_MORM] else 0.0
+    out_err[1] = (err2 if do_a else tot2) if flags[DO_AMP] else 0.0
     sx, sy, nx, ny = sens[0], sens[1], sens[2], sens[3]
     if do_m:
         place_sensors(ax, ay, heading, trig[0, :sm], trig[1, :sm], c[R_SENS], sx[:sm], sy[:sm], nx[:sm], ny[:sm])
@@ -374,6 +381,7 @@ def sense_arenas(batch, plan, ws, out):
     """
     c, flags, n, out_m, out_a, out_k = (plan.c, plan.flags, batch.agent_xy.shape[1], out.mormyromast, out.ampullary,
                                         out.knollenorgan)
+    out_err = out.error_bound
     agent_xy, heading, emits, pellet_phi = batch.agent_xy, batch.heading, batch.emitting, batch.pellet_phi
     bodies, lists, stage = ws.bodies, ws.lists, ws.staging
     body, p_ind, angles, sin_t, cos_t = bodies.body, bodies.p_ind, bodies.angles, bodies.sin_t, bodies.cos_t
@@ -399,7 +407,7 @@ def sense_arenas(batch, plan, ws, out):
                             p_ind)
         s_max = t1_moments(arena, nb, share and flags[DO_MORM] and induction, c, bodies)
         list_images(body[B_X, :nb], body[B_Y, :nb], body[B_M2X, :nb], body[B_M2Y, :nb], img, n, lst, own, owner)
-        srcs = SourceList(lst, own, owner, nb * img.shape[0], 0, False, 0.0, 0.0)  # every agent stages all sources
+        srcs = SourceList(lst, own, owner, nb * img.shape[0], 0, False, 0.0, 0.0, 0.0, 0.0)  # all sources, per agent
         if share and sense:  # or only those that are not shared
             image_rows(img, body[B_T1X, :nb], body[B_T1Y, :nb], lst[L_T1X], lst[L_T1Y], lst[L_A1])
             srcs = share_far_sources(srcs.n, axy, s_max, c, level_lcq, level_e, lists, stage)
@@ -417,7 +425,7 @@ def sense_arenas(batch, plan, ws, out):
                     m1x[:] = c[ZERO]
                     m1y[:] = c[ZERO]
                 imaged_moments(img, m1x, m1y, geo)
-            sense_agent(a, arena, srcs, plan, stage, out_m[b, a], out_a[b, a])
+            sense_agent(a, arena, srcs, plan, stage, out_m[b, a], out_a[b, a], out_err[b, a])
         if flags[DO_KNOLL]:
             knollenorgan_env(arena, c, flags[CULL], cos_k, sin_k, out_k[b])
 

@@ -43,6 +43,10 @@ S_X, S_Y, S_T1X, S_T1Y, S_M2X, S_M2Y, N_SHARED = range(7)
 BLOCK = 16
 EXACT_BLOCK = 8
 MITCHELL_ERROR = 0.0861  # max of log2(1 + f) - f on [0, 1]: the bit-pattern log2 is at most this low
+# Round-off of an interpolated source, evaluated in float32, as a fraction of its bound: positions
+# relative to the agent (a relative eps on D, about 4 eps on the field), the dipole formula (about 10
+# ulp) and the float32 sums over the sources of each SIMD lane (growing like sqrt(count) eps), padded.
+F32_ROUNDOFF = 64 * float(np.finfo(np.float32).eps)
 NOBODY = -1  # ``own``/``owner`` of a source that is no agent's
 
 
@@ -125,18 +129,39 @@ def source_bounds(a, d2, own, a1, a2, inv1, inv2, r, geo):
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
 def cull_column(a, mag, mx, my, own, unit, thr, out_x, out_y):
-    """One column's moments, 0 where the bound |m| * unit is below ``thr``; returns the bound sum.
+    """One column's moments, 0 where the bound |m| * unit is below ``thr``; returns the bound sums of
+    every source and of the culled ones (what culling may have left out of the readings).
 
     ``a``'s own body is dropped (see :func:`source_bounds`), also when nothing is culled (thr < 0).
     """
-    total = 0.0  # bounds steer decisions only: float64 whatever the dtype
+    total = skipped = 0.0  # bounds steer decisions only: float64 whatever the dtype
     for t in range(unit.shape[0]):
         b = mag[t] * unit[t]
         total += b
+        skipped += b * (b < thr)
         keep = (mag[t] > 0) & (b >= thr) & (own[t] != a)
         out_x[t] = mx[t] * keep
         out_y[t] = my[t] * keep
-    return total
+    return total, skipped
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def level_error(member, d2, unit, a1, a2, keep1, keep2, cq, e, r):
+    """Sum over the members of one far level of its error bound, C Q B (r/D)^e plus float32 round-off, per column.
+
+    ``member``, ``keep1``, ``keep2``: nonzero where a source belongs to the level and where its
+    column was kept; ``cq`` = C Q and ``e`` the level's order (see :func:`dense_level_sources`).
+    """
+    err1 = err2 = 0.0
+    for k in range(d2.shape[0]):
+        x = min(r / np.sqrt(d2[k] + 1e-300), 1.0)  # members are farther than r; others must not overflow
+        xe = 1.0
+        for _ in range(e):
+            xe *= x
+        f = (cq * xe + F32_ROUNDOFF) * unit[k] * (member[k] != 0)
+        err1 += f * a1[k] * (keep1[k] != 0)
+        err2 += f * a2[k] * (keep2[k] != 0)
+    return err1, err2
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
@@ -271,12 +296,16 @@ def share_far_sources(n, axy, s_max, c, level_lcq, level_e, lists, stage):
     for k in range(n):
         rest_index[n_rest] = k
         n_rest += (flag[k] == 0) | (owner[k] != NOBODY)
+    # their interpolation error at the nearest agent bounds it at every agent (farther, weight <= s_max)
+    err1, err2 = level_error(flag[:n] & (owner == NOBODY), d2, unit, a1, a2, a1, a2, 2.0 ** level_lcq[0],
+                             int(level_e[0]), c[R_SENS])
     copy_columns(lst, (L_X, L_Y, L_T1X, L_T1Y, L_M2X, L_M2Y), order, n_shared, lists.shared, 0)
     copy_columns(lst, (L_X, L_Y, L_T1X, L_T1Y, L_M2X, L_M2Y, L_A1, L_A2), rest_index, n_rest, lists.rest, 0)
     rest_own, rest_owner = lists.rest_own, lists.rest_owner
     for t in range(n_rest):
         rest_own[t], rest_owner[t] = own[rest_index[t]], owner[rest_index[t]]
-    return SourceList(lists.rest, rest_own, rest_owner, n_rest, n_shared, True, total1 * s_max, total2)
+    return SourceList(lists.rest, rest_own, rest_owner, n_rest, n_shared, True, total1 * s_max, total2,
+                      err1 * s_max, err2)
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
@@ -328,6 +357,31 @@ def bucket_offsets(bucket, offsets):
         offsets[lv + 1] = offsets[lv] + -(-offsets[lv + 1] // block) * block
 
 
+@njit(cache=True, error_model="numpy")
+def staged_error(n, geo, a2, in_dense, bucket, level_lcq, level_e, r):
+    """Error bound of an agent's staged interpolated sources, both columns: the sum of :func:`level_error` over levels.
+
+    Kept columns are the nonzero moments of ``geo`` rows G_M1X ... G_M2Y; ``bucket`` as in
+    :func:`source_buckets` (level l in bucket l + 1; the first level is ``in_dense``).
+    """
+    d2, unit, a1 = geo[G_D2, :n], geo[G_UNIT, :n], geo[G_A1, :n]
+    keep1, keep2 = geo[G_KEEP, :n], geo[G_LS, :n]  # G_LS is free once the buckets are chosen
+    for k in range(n):
+        keep1[k] = (geo[G_M1X, k] != 0) | (geo[G_M1Y, k] != 0)
+        keep2[k] = (geo[G_M2X, k] != 0) | (geo[G_M2Y, k] != 0)
+    if level_e.shape[0] == 0:
+        return 0.0, 0.0
+    err1, err2 = level_error(in_dense[:n], d2, unit, a1, a2, keep1, keep2, 2.0 ** level_lcq[0], int(level_e[0]), r)
+    member = geo[G_LX, :n]  # G_LX is free too: the members of each higher level
+    for lv in range(1, level_e.shape[0]):
+        for k in range(n):
+            member[k] = bucket[k] == lv + 1
+        e1, e2 = level_error(member, d2, unit, a1, a2, keep1, keep2, 2.0 ** level_lcq[lv], int(level_e[lv]), r)
+        err1 += e1
+        err2 += e2
+    return err1, err2
+
+
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
 def gather_sources(a, ax, ay, thr1, thr2, srcs, c, level_lcq, level_e, stage):
     """Stage the listed sources of ``srcs`` whose bound at agent ``a`` (at (ax, ay)) reaches a threshold, by level.
@@ -343,7 +397,8 @@ def gather_sources(a, ax, ay, thr1, thr2, srcs, c, level_lcq, level_e, stage):
     working dtype, higher levels to the same columns of ``stage.far`` in float32
     (bucket 1, the dense level, stays empty); every bucket is padded with inert sources
     (moment 0, 1 m away), so its loops have no scalar remainder. Returns the number of
-    dense columns (0 without far levels) and the bound sums of both columns.
+    dense columns (0 without far levels), the bound sums of both columns and the error
+    bounds of both columns: the bounds of the culled sources plus :func:`staged_error`.
     """
     n, n_shared, lst, geo, in_dense, dense = srcs.n, srcs.n_shared, srcs.lst, stage.geo, stage.in_dense, stage.dense
     own, x, y, d2 = srcs.own[:n], lst[L_X, :n], lst[L_Y, :n], geo[G_D2, :n]
@@ -352,10 +407,10 @@ def gather_sources(a, ax, ay, thr1, thr2, srcs, c, level_lcq, level_e, stage):
     inv2 = 1.0 / thr2 if thr2 > 0 else 0.0
     source_bounds(a, d2, own, geo[G_A1, :n], lst[L_A2, :n], inv1, inv2, c[R_SENS], geo)
     unit = geo[G_UNIT, :n]
-    total1 = cull_column(a, geo[G_A1, :n], geo[G_P1X, :n], geo[G_P1Y, :n], own, unit, thr1, geo[G_M1X, :n],
-                         geo[G_M1Y, :n])
-    total2 = cull_column(a, lst[L_A2, :n], lst[L_M2X, :n], lst[L_M2Y, :n], own, unit, thr2, geo[G_M2X, :n],
-                         geo[G_M2Y, :n])
+    total1, skipped1 = cull_column(a, geo[G_A1, :n], geo[G_P1X, :n], geo[G_P1Y, :n], own, unit, thr1,
+                                   geo[G_M1X, :n], geo[G_M1Y, :n])
+    total2, skipped2 = cull_column(a, lst[L_A2, :n], lst[L_M2X, :n], lst[L_M2Y, :n], own, unit, thr2,
+                                   geo[G_M2X, :n], geo[G_M2Y, :n])
     for k in range(n):
         geo[G_KEEP, k] = (geo[G_M1X, k] != 0) | (geo[G_M1Y, k] != 0) | (geo[G_M2X, k] != 0) | (geo[G_M2Y, k] != 0)
     n_levels = level_e.shape[0]
@@ -386,4 +441,5 @@ def gather_sources(a, ax, ay, thr1, thr2, srcs, c, level_lcq, level_e, stage):
         if offsets[lv + 1] > offsets[lv]:
             end = fill_bucket(bucket, lv, x, y, geo, ax, ay, members, far, offsets[lv])
             pad_bucket(far, end, offsets[lv + 1], 0.0)
-    return n_dense, total1, total2
+    err1, err2 = staged_error(n, geo, lst[L_A2, :n], in_dense, bucket, level_lcq, level_e, c[R_SENS])
+    return n_dense, total1, total2, skipped1 + err1, skipped2 + err2
