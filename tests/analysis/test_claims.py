@@ -17,7 +17,9 @@ from efish.analysis.behaviour import (
 )
 from efish.analysis.claim_parts import ROW_COLUMNS, bootstrap_ci, combined_verdict, judge
 from efish.analysis.claims_report import claims_markdown, compare_claims, load_claims
+from efish.analysis.dynamics_tests import power_near_far, power_tests, size_tests
 from efish.analysis.interactions import size_role_tests
+from efish.analysis.onepatch import reach_tests, role_tests
 from efish.analysis.registry import SUMMARY_MEASURES, run
 from efish.analysis.signalling import fit_power_law
 from efish.analysis.stats import dunnett_by_measure, spearman
@@ -218,7 +220,8 @@ def c14(flip):
         rows += [{"condition": "A_alone", "episode": e, "agent": 0, "size": 0.5, "food_eaten": 5 + rng.normal()},
                  {"condition": "B_alone", "episode": e, "agent": 0, "size": 0.5,
                   "food_eaten": (10 if flip else 2) + rng.normal(0, 0.3)}]
-    return {A("behaviour", "onepatch", "food_per_agent"): pd.DataFrame(rows)}
+    food = pd.DataFrame(rows)
+    return {A("behaviour", "onepatch", "food_per_agent"): food, A("onepatch", "onepatch", "role_tests"): role_tests(food)}
 
 
 def c15(flip):
@@ -231,7 +234,8 @@ def c15(flip):
                          "n_reached": 10 - k if flip else k})
             rows.append({"condition": f"bot0.5_B0.5_rate{rate:g}_{motion}", "agent": 0, "n_episodes": 10,
                          "n_reached": 0})
-    return {A("onepatch", "bot", "reach_rates"): pd.DataFrame(rows)}
+    reach = pd.DataFrame(rows)
+    return {A("onepatch", "bot", "reach_rates"): reach, A("onepatch", "bot", "reach_tests"): reach_tests(reach)}
 
 
 def square_steps(flip: bool, episodes: int = 10, steps: int = 200) -> pd.DataFrame:
@@ -277,8 +281,9 @@ def c17(flip):
         no_k = (2 * n + rng.normal(0, 0.3, 10)) if flip else flat
         rows += [pd.DataFrame({"condition": f"n{n}_K", "episode": np.arange(10), "agent": 0, "d_eff": k}),
                  pd.DataFrame({"condition": f"n{n}_noK", "episode": np.arange(10), "agent": 0, "d_eff": no_k})]
-    return {A("dynamics", "patchy4", "dimensionality"): patchy,
-            A("dynamics", "groupsize", "dimensionality"): pd.concat(rows, ignore_index=True)}
+    groupsize = pd.concat(rows, ignore_index=True)
+    return {A("dynamics", "patchy4", "dimensionality"): patchy, A("dynamics", "groupsize", "dimensionality"): groupsize,
+            A("dynamics", "groupsize", "size_tests"): size_tests(groupsize)}
 
 
 def hidden_of(steps: pd.DataFrame, columns: dict[str, np.ndarray], units: int = 6, seed: int = 0) -> pd.DataFrame:
@@ -347,7 +352,13 @@ def c21(flip):
                              "agent": np.tile([0, 1], 10), "size": np.tile([0.3, 0.7], 10)})
     power = np.where(episodes["agent"] == (1 if flip else 0), 2.0, 1.0) + rng.normal(0, 0.1, 20)
     dims = episodes.drop(columns="size").assign(wideband_power=power)
-    return {**tables, R("wide2", "episodes"): episodes, A("dynamics", "wide2", "dimensionality"): dims}
+    steps = tables[R("wide2", "steps")].merge(episodes, on=["condition", "episode", "agent"])
+    a = CFG.analysis
+    near_far = power_near_far(tables[R("wide2", "hidden")], steps, a.claims_near_cm, a.claims_far_cm,
+                              a.spectrogram_window, a.spectrogram_overlap, CFG.env.fps)
+    return {R("wide2", "steps"): steps, A("dynamics", "wide2", "dimensionality"): dims,
+            A("dynamics", "wide2", "power_near_far"): near_far,
+            A("dynamics", "wide2", "power_tests"): power_tests(near_far, dims, steps)}
 
 
 BUILDERS = {f"C{i}": f for i, f in enumerate([c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, c11, c12, c13, c14, c15,

@@ -101,6 +101,28 @@ def test_food_of_b_draws_b_food_of_every_condition(synthetic_results):
     assert labels == ["A<B", "A=B", "A>B", "B alone"]
 
 
+def test_food_panels_read_their_stars_from_role_tests(synthetic_results):
+    tables = load_tables(PANELS["fig5/E"], synthetic_results, 2)
+    tests = tables["tests"]
+    assert set(tests["role"].dropna()) == {"A", "B"}  # the real onepatch analysis wrote the table
+    marked = tests.assign(stars=[f"S{i}" for i in range(len(tests))])
+    ax = draw("fig5/E", synthetic_results, {**tables, "tests": marked})
+    b_rows = marked[marked["role"] == "B"].set_index("group")["stars"]
+    assert {t.get_text() for t in ax.texts} >= set(b_rows)  # each social box carries its own row's stars
+    ax = draw("fig5/F", synthetic_results, {**tables, "tests": marked})
+    a_row = marked.loc[marked["role"] == "A", "stars"].item()
+    assert any(t.get_text() == f"vs social: {a_row}" for t in ax.texts)
+
+
+@pytest.mark.parametrize(("key", "contrast"), [("fig5/I", "mobility"), ("fig5/J", "eod")])
+def test_bot_reach_panels_read_their_stars_from_reach_tests(key, contrast, synthetic_results):
+    tables = load_tables(PANELS[key], synthetic_results, 2)
+    assert set(tables["tests"]["contrast"]) == {"mobility", "eod"}
+    marked = tables["tests"].assign(stars=lambda t: "X" + t["contrast"])
+    ax = draw(key, synthetic_results, {**tables, "tests": marked})
+    assert [t.get_text() for t in ax.texts if t.get_text().startswith("X")] == [f"X{contrast}"]
+
+
 def test_food_time_course_lines_are_the_table_means(synthetic_results):
     tables = load_tables(PANELS["fig5/H"], synthetic_results, 2)
     ax = draw("fig5/H", synthetic_results, tables)

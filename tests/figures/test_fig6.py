@@ -13,7 +13,7 @@ from efish.figures.style import panel_style
 
 FIG6 = [key for key in PANELS if key.startswith("fig6/")]
 #: Panels whose data no analysis table holds yet: they say so on themselves.
-NOT_ANALYSED = {"fig6/F", "fig6/I"}
+NOT_ANALYSED = {"fig6/F"}
 
 
 def draw(key: str, tables: dict):
@@ -75,7 +75,9 @@ def test_power_by_size_puts_each_agent_in_its_size_class_and_drops_equal_sizes()
                          "wideband_power": [1.0, 2.0, 4.0, 3.0, 9.0, 9.5], "reason": ""})
     episodes = pd.DataFrame({"condition": "control", "episode": [0, 0, 1, 1, 2, 2], "agent": [0, 1] * 3,
                              "size": [0.2, 0.8, 0.9, 0.1, 0.5, 0.5]})
-    ax = draw("fig6/J", {"dims": dims, "episodes": episodes})
+    tests = pd.DataFrame({"measure": ["near_far", "size"], "stars": ["XNEAR", "XSIZE"]})
+    ax = draw("fig6/J", {"dims": dims, "episodes": episodes, "tests": tests})
+    assert [t for t in texts(ax) if t.startswith("X")] == ["XSIZE"]
     by_x = {}
     for c in ax.collections:
         for x, y in c.get_offsets():
@@ -94,7 +96,25 @@ def test_group_size_and_knollenorgans_come_from_the_condition_names():
 def test_deff_vs_group_size_means_per_knollenorgan_state():
     dims = pd.DataFrame({"condition": ["n1_K", "n1_K", "n2_K", "n1_noK", "n2_noK"], "d_eff": [2.0, 4.0, 5.0, 1.0, 1.5],
                          "reason": ""})
-    ax = draw("fig6/B", {"dims": dims})
+    tests = pd.DataFrame({"group": ["K", "noK"], "effect": [0.5, np.nan], "stars": ["XK", "n/a"]})
+    ax = draw("fig6/B", {"dims": dims, "tests": tests})
+    assert texts(ax)[-1] == "K on: rho +0.50 XK\nK off: n/a"
     means = {c.get_label(): c.lines[0].get_ydata() for c in ax.containers}
     np.testing.assert_allclose(means["K on"], [3.0, 5.0])
     np.testing.assert_allclose(means["K off"], [1.0, 1.5])
+
+
+def test_power_near_far_draws_each_agent_episode_and_the_wilcoxon_stars():
+    power = pd.DataFrame({"condition": "control", "episode": [0, 0, 1, 1], "agent": 0,
+                          "where": ["near", "far"] * 2, "wideband_power": [1.0, 3.0, 2.0, 5.0], "reason": ""})
+    tests = pd.DataFrame({"measure": ["near_far", "size"], "stars": ["XNEAR", "XSIZE"]})
+    ax = draw("fig6/I", {"power": power, "tests": tests})
+    by_x = {}
+    for c in ax.collections:
+        for x, y in c.get_offsets():
+            by_x.setdefault(round(x), []).append(y)
+    assert sorted(by_x[0]) == [1.0, 2.0] and sorted(by_x[1]) == [3.0, 5.0]
+    assert [t for t in texts(ax) if t.startswith("X")] == ["XNEAR"]
+    nan_row = pd.DataFrame([{"where": np.nan, "wideband_power": np.nan, "reason": "the rollout table lacks x"}])
+    ax = draw("fig6/I", {"power": nan_row, "tests": tests})
+    assert any("lacks x" in t for t in texts(ax))

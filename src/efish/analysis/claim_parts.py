@@ -226,14 +226,6 @@ def wilcoxon_vs(values, reference: float) -> pd.Series:
     return wilcoxon_paired(long, "v", "role", "reference", "pair").iloc[0]
 
 
-def fisher_rates(k1: int, n1: int, k2: int, n2: int) -> tuple[float, float]:
-    """Rate difference k1/n1 - k2/n2 and the two-sided p of Fisher's exact test; ValueError for an empty group."""
-    if n1 <= 0 or n2 <= 0:
-        raise ValueError(f"an empty group ({n1} and {n2} trials)")
-    res = sps.fisher_exact([[k1, n1 - k1], [k2, n2 - k2]])
-    return k1 / n1 - k2 / n2, float(res.pvalue)
-
-
 def heldout_skill(x: np.ndarray, targets: dict[str, tuple[np.ndarray, bool]], groups: np.ndarray,
                   folds: int) -> pd.DataFrame:
     """Held-out decoding skill of each target per group (episode): 1 - MSE(readout) / MSE(train mean).

@@ -18,9 +18,10 @@ Condition names are those of ``config/assay/<assay>.yaml``.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import re
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 
 import numpy as np
@@ -38,12 +39,12 @@ from .claim_parts import (
     Part,
     analysis_table,
     claim,
-    fisher_rates,
     from_row,
     heldout_skill,
     joined,
     mann_whitney_part,
     mean_diff,
+    median_diff,
     median_minus,
     ols_part,
     one_sample_part,
@@ -55,12 +56,14 @@ from .claim_parts import (
     spearman_part,
     stat_row,
 )
-from .dynamics import DECODE_TARGETS, plsc, wideband_power
+from .dynamics import DECODE_TARGETS, plsc
+from .dynamics_tests import groupsize_parts, smaller_larger
 from .homing import error_angles
 from .interactions import bite_rate_by_class
+from .onepatch import REACH_CONTRASTS, SOCIAL, bot_reach_counts, roles
 from .registry import ANALYSES, tables_written
 from .signalling import EVENTS, peri_event_rate
-from .stats import spearman, wilcoxon_paired
+from .stats import fisher_rates, spearman
 
 __all__ = ["CLAIMS", "ROW_COLUMNS", "claim_tables", "claims_table", "produced_tables"]
 
@@ -383,70 +386,56 @@ def c13(ctx: Context) -> list[Part]:
 
 # --------------------------------------------------------------- Fig 5
 ONEPATCH_FOOD = analysis_table("behaviour", "onepatch", "food_per_agent")
-# config/assay/onepatch.yaml: agent 0 is resident A, agent 1 intruder B; alone, the one agent (0) is A or B
-SOCIAL = ("A_gt_B", "A_eq_B", "A_lt_B")  # B's size rising
-
-
-def _roles(food: pd.DataFrame) -> pd.DataFrame:
-    """food_per_agent of the one-patch assay with ``role`` A or B and ``setting`` (social condition or alone)."""
-    alone = food["condition"].isin(["A_alone", "B_alone"])
-    role = np.where(alone, food["condition"].str[0], np.where(food["agent"] == 0, "A", "B"))
-    return food.assign(role=role, setting=np.where(alone, "alone", food["condition"]))
+ROLE_TESTS = analysis_table("onepatch", "onepatch", "role_tests")
 
 
 @claim("C14", "5E-H", "intruder B eats more with A present than alone; A is unaffected; B does better when larger",
-       [ONEPATCH_FOOD])
+       [ONEPATCH_FOOD, ROLE_TESTS])
 def c14(ctx: Context) -> list[Part]:
-    def b_social(condition: str) -> Outcome:
-        b = _roles(ctx.table(ONEPATCH_FOOD)).query("role == 'B'")
-        return mann_whitney_part(ctx, b, "food_eaten", "setting", condition, "alone", +1)
-
-    def a_social() -> Outcome:
-        a = _roles(ctx.table(ONEPATCH_FOOD)).query("role == 'A'")
-        a = a.assign(setting=np.where(a["setting"] == "alone", "alone", "social"))
-        return mann_whitney_part(ctx, a, "food_eaten", "setting", "social", "alone", 0)
+    def social(role: str, group: str, sign: int) -> Outcome:
+        """The onepatch analysis's Mann-Whitney row of ``role``; interval over its food_per_agent episodes."""
+        row = stat_row(ctx.table(ROLE_TESTS), role=role, group=group)
+        food = roles(ctx.table(ONEPATCH_FOOD)).query("role == @role")
+        if group == "social":  # A's social conditions are pooled
+            food = food.assign(setting=np.where(food["setting"] == "alone", "alone", "social"))
+        food = food[food["setting"].isin([group, "alone"])]
+        return from_row(row, sign, ctx.ci(food, median_diff("food_eaten", "setting", group, "alone"), strata="setting"))
 
     def b_size() -> Outcome:
-        b = _roles(ctx.table(ONEPATCH_FOOD)).query("role == 'B' and setting != 'alone'")
+        b = roles(ctx.table(ONEPATCH_FOOD)).query("role == 'B' and setting != 'alone'")
         return spearman_part(ctx, b[b["setting"].isin(SOCIAL)], "size", "food_eaten", +1)
-    stat = "median food of B with A ({}) minus B alone; Mann-Whitney"
-    return ([ctx.part(f"B social, {c}", stat.format(c), functools.partial(b_social, c)) for c in SOCIAL]
-            + [ctx.part("A social vs alone (n.s.)", "median food of A with B minus A alone; Mann-Whitney", a_social),
+    stat = "median food of B with A ({}) minus B alone; Mann-Whitney (onepatch role_tests)"
+    return ([ctx.part(f"B social, {c}", stat.format(c), functools.partial(social, "B", c, +1)) for c in SOCIAL]
+            + [ctx.part("A social vs alone (n.s.)", "median food of A with B minus A alone; Mann-Whitney (onepatch "
+                        "role_tests)", functools.partial(social, "A", "social", 0)),
                ctx.part("B food vs B size", "Spearman rho of B's food against B's size over the social conditions",
                         b_size)])
 
 
 BOT_REACH = analysis_table("onepatch", "bot", "reach_rates")
-BOT = re.compile(r"rate([0-9.]+)_(frozen|moving)$")  # config/assay/bot.yaml
-BOT_B = 1  # the bot is agent 0, the trained agent B is agent 1
+BOT_REACH_TESTS = analysis_table("onepatch", "bot", "reach_tests")
 
 
-def _reach(ctx: Context, group: Callable[[pd.DataFrame], pd.Series], a: str, b: str) -> Outcome:
-    """B's reach rate in group ``a`` minus ``b`` (pooled episodes), Fisher's exact test, interval over episodes."""
-    r = ctx.table(BOT_REACH)
-    r = r[r["agent"] == BOT_B]
-    m = r["condition"].astype(str).str.extract(BOT)
-    r = r.assign(rate=pd.to_numeric(m[0]), motion=m[1]).dropna(subset=["rate"])
-    r = r.assign(group=group(r))
-    counts = r.groupby("group")[["n_reached", "n_episodes"]].sum()
+def _reach(ctx: Context, contrast: str) -> Outcome:
+    """The onepatch analysis's Fisher row of B's reach rate (pooled episodes); interval over episodes."""
+    row = stat_row(ctx.table(BOT_REACH_TESTS), contrast=contrast)
+    a, b = REACH_CONTRASTS[contrast]
+    counts = bot_reach_counts(ctx.table(BOT_REACH), contrast)
     present(counts.reset_index(), "group", [a, b], "bot episodes")
-    diff, p = fisher_rates(*counts.loc[a].astype(int), *counts.loc[b].astype(int))
     # one row per episode (reached or not): the reach table's counts, resampled as episodes
     per = pd.DataFrame([{"condition": g, "episode": i, "reached": i < k}
-                        for g, (k, n) in counts.astype(int).iterrows() for i in range(n)])
+                        for g, (k, n) in counts.iterrows() for i in range(n)])
     ci = ctx.ci(per.assign(reached=per["reached"].astype(float)), mean_diff("reached", "condition", a, b))
-    return Outcome(diff, p, int(counts["n_episodes"].sum()), +1, ci)
+    return dataclasses.replace(from_row(row, +1, ci), n=int(counts["n_episodes"].sum()))
 
 
 @claim("C15", "5I,J", "B reaches the patch more often when the bot is frozen, and when it emits than when silent",
-       [BOT_REACH])
+       [BOT_REACH, BOT_REACH_TESTS])
 def c15(ctx: Context) -> list[Part]:
-    frozen = functools.partial(_reach, ctx, lambda r: r["motion"], "frozen", "moving")
-    emits = functools.partial(_reach, ctx, lambda r: np.where(r["rate"] > 0, "emitting", "silent"), "emitting",
-                              "silent")
-    return [ctx.part("frozen vs moving bot", "B's reach rate with the bot frozen minus moving; Fisher exact", frozen),
-            ctx.part("emitting vs silent bot", "B's reach rate with bot EOD rate > 0 minus rate 0; Fisher exact",
-                     emits)]
+    return [ctx.part("frozen vs moving bot", "B's reach rate with the bot frozen minus moving; Fisher exact "
+                     "(onepatch reach_tests)", functools.partial(_reach, ctx, "mobility")),
+            ctx.part("emitting vs silent bot", "B's reach rate with bot EOD rate > 0 minus rate 0; Fisher exact "
+                     "(onepatch reach_tests)", functools.partial(_reach, ctx, "eod"))]
 
 
 SQUARE2_STEPS = rollout_table("square2", "steps")
@@ -490,11 +479,11 @@ def c16(ctx: Context) -> list[Part]:
 
 
 # --------------------------------------------------------------- Fig 6
-GROUPSIZE = re.compile(r"n(\d+)_(K|noK)$")  # config/assay/groupsize.yaml
+GROUPSIZE_TESTS = analysis_table("dynamics", "groupsize", "size_tests")
 
 
 @claim("C17", "6A-C", "hidden dynamics are low-dimensional; D_eff grows with group size only with Knollenorgans",
-       [analysis_table("dynamics", a, "dimensionality") for a in ("patchy4", "groupsize")])
+       [analysis_table("dynamics", a, "dimensionality") for a in ("patchy4", "groupsize")] + [GROUPSIZE_TESTS])
 def c17(ctx: Context) -> list[Part]:
     a, width = ctx.cfg.analysis, ctx.cfg.train.hidden
 
@@ -504,16 +493,16 @@ def c17(ctx: Context) -> list[Part]:
         return one_sample_part(ctx, dims, "fraction", a.claims_deff_fraction, -1)
 
     def grows(knollen: str, sign: int) -> Outcome:
-        dims = ctx.table(analysis_table("dynamics", "groupsize", "dimensionality"))
-        m = dims["condition"].astype(str).str.extract(GROUPSIZE)
-        dims = dims.assign(n_agents=pd.to_numeric(m[0]), k=m[1])
-        return spearman_part(ctx, dims[dims["k"] == knollen], "n_agents", "d_eff", sign)
+        """The dynamics analysis's Spearman row (size_tests); interval over its dimensionality episodes."""
+        row = stat_row(ctx.table(GROUPSIZE_TESTS), group=knollen)
+        dims = groupsize_parts(ctx.table(analysis_table("dynamics", "groupsize", "dimensionality")))
+        return from_row(row, sign, ctx.ci(dims[dims["knollenorgans"] == knollen], rho_of("n_agents", "d_eff")))
     return [ctx.part("low-dimensional", f"median D_eff / width ({width}) minus {a.claims_deff_fraction} (patchy4); "
                      "Wilcoxon", low),
-            ctx.part("D_eff grows with N, K on", "Spearman rho(D_eff, N) over agent-episodes, Knollenorgans on",
-                     functools.partial(grows, "K", +1)),
-            ctx.part("K off (n.s.)", "Spearman rho(D_eff, N) over agent-episodes, Knollenorgans off",
-                     functools.partial(grows, "noK", 0))]
+            ctx.part("D_eff grows with N, K on", "Spearman rho(D_eff, N) over agent-episodes, Knollenorgans on "
+                     "(dynamics size_tests)", functools.partial(grows, "K", +1)),
+            ctx.part("K off (n.s.)", "Spearman rho(D_eff, N) over agent-episodes, Knollenorgans off (dynamics "
+                     "size_tests)", functools.partial(grows, "noK", 0))]
 
 
 @claim("C18", "6D", "the Knollenorgan error angle is decoded better than the straight bearing to the target",
@@ -621,41 +610,33 @@ def c20(ctx: Context) -> list[Part]:
                      "pooled PLSC (wide2)", collapse)]
 
 
+POWER_TESTS, POWER_NEAR_FAR = (analysis_table("dynamics", "wide2", t) for t in ("power_tests", "power_near_far"))
+WIDE2_DIMS = analysis_table("dynamics", "wide2", "dimensionality")
+
+
 @claim("C21", "6I,J", "a nearby conspecific lowers wideband power; smaller agents carry more",
-       [WIDE2_HIDDEN, WIDE2_STEPS, analysis_table("dynamics", "wide2", "dimensionality"), WIDE2_EPISODES])
+       [POWER_TESTS, POWER_NEAR_FAR, WIDE2_DIMS, WIDE2_STEPS])
 def c21(ctx: Context) -> list[Part]:
     a = ctx.cfg.analysis
 
     def near_far() -> Outcome:
-        j, h = joined(ctx, WIDE2_HIDDEN, WIDE2_STEPS, ["dist_agent_cm"])
-        rows = []
-        for keys, sub in j.groupby(AGENT_EPISODE):
-            d = sub["dist_agent_cm"].to_numpy()
-            for where, keep in (("near", d <= a.claims_near_cm), ("far", d > a.claims_far_cm)):
-                power = wideband_power(sub[h].to_numpy()[keep], a.spectrogram_window, a.spectrogram_overlap,
-                                       ctx.cfg.env.fps)
-                rows.append({**dict(zip(AGENT_EPISODE, keys, strict=True)), "where": where, "power": power})
-        long = pd.DataFrame(rows).dropna(subset=["power"])
-        long = long.assign(unit=long["episode"].astype(str) + "|" + long["agent"].astype(str))
-        present(long, "where", ["near", "far"], "hidden states long enough for a spectrogram")
-        row = wilcoxon_paired(long, "power", "where", "near", "unit").iloc[0]
-        wide = long.pivot(index=["episode", "agent"], columns="where", values="power")
+        """The dynamics analysis's Wilcoxon row; interval over agent-episodes of power_near_far."""
+        row = stat_row(ctx.table(POWER_TESTS), measure="near_far")
+        wide = ctx.table(POWER_NEAR_FAR).pivot(index=AGENT_EPISODE, columns="where", values="wideband_power")
+        wide = wide.reindex(columns=["near", "far"])
         diff = (wide["far"] - wide["near"]).dropna().rename("diff").reset_index()
         return from_row(row, +1, ctx.ci(diff, median_minus("diff", 0.0), strata=None))
 
     def smaller() -> Outcome:
-        dims = ctx.table(analysis_table("dynamics", "wide2", "dimensionality"))
-        sizes = ctx.table(WIDE2_EPISODES)[AGENT_EPISODE + ["size"]]
-        d = dims.merge(sizes, on=AGENT_EPISODE)
-        rank = d.groupby(["condition", "episode"])["size"].rank(method="min")
-        equal = d.groupby(["condition", "episode"])["size"].transform("nunique") < 2
-        d = d.assign(role=np.where(rank == 1, "smaller", "larger"))[~equal.to_numpy()]
-        return mann_whitney_part(ctx, d.dropna(subset=["wideband_power"]), "wideband_power", "role", "smaller",
-                             "larger", +1)
+        """The dynamics analysis's Mann-Whitney row; interval over episodes of the dimensionality table."""
+        row = stat_row(ctx.table(POWER_TESTS), measure="size")
+        d = smaller_larger(ctx.table(WIDE2_DIMS), ctx.table(WIDE2_STEPS)).dropna(subset=["wideband_power"])
+        return from_row(row, +1, ctx.ci(d, median_diff("wideband_power", "role", "smaller", "larger"), strata="role"))
     return [ctx.part("far > near", f"median over agent-episodes of wideband power with the conspecific beyond "
-                     f"{a.claims_far_cm:g} cm minus within {a.claims_near_cm:g} cm; Wilcoxon", near_far),
+                     f"{a.claims_far_cm:g} cm minus within {a.claims_near_cm:g} cm; Wilcoxon (dynamics power_tests)",
+                     near_far),
             ctx.part("smaller carries more", "median wideband power of the smaller minus the larger agent per "
-                     "episode (wide2); Mann-Whitney", smaller)]
+                     "episode (wide2); Mann-Whitney (dynamics power_tests)", smaller)]
 
 
 # ------------------------------------------------------------------ API

@@ -40,8 +40,10 @@ from .behaviour import (
     win_ratios,
 )
 from .dynamics import decode_table, dynamics_table, plsc_table, subsample_table
+from .dynamics_tests import power_near_far, power_tests, size_tests
 from .homing import ERROR_COLUMNS, compare_perception, error_histogram, error_vs_time, trajectory_shape
 from .interactions import bite_rate_by_class, bite_sizes, bite_timing, bouts, chase_sizes, label_counts, size_role_tests
+from .onepatch import food_from_steps, reach_tests, role_tests
 from .signalling import (
     EVENTS,
     eod_rate_by_distance,
@@ -194,16 +196,18 @@ def _homing(t: Tables, cfg: EfishConfig) -> Tables:
 
 # --------------------------------------------------------------- onepatch
 def _onepatch(t: Tables, cfg: EfishConfig) -> Tables:
-    """Cumulative food over time and reach rates of the arena's central patch (Fig 5G-J)."""
+    """Cumulative food over time, reach rates of the arena's central patch, and the tests by role (Fig 5E-J)."""
     steps, arena = t["steps"], cfg.arena
     centre = (arena.width_cm / 2, arena.height_cm / 2)
-    return {"food_time_course": food_time_course(steps),
-            "reach_rates": reach_rates(steps, centre, arena.onepatch_radius_cm)}
+    reach = reach_rates(steps, centre, arena.onepatch_radius_cm)
+    return {"food_time_course": food_time_course(steps), "reach_rates": reach,
+            "role_tests": role_tests(food_from_steps(steps)), "reach_tests": reach_tests(reach)}
 
 
 # --------------------------------------------------------------- dynamics
 def _dynamics(t: Tables, cfg: EfishConfig) -> Tables:
-    """Hidden-state dimensionality, power, unit subsampling, decoding, PLSC of agents 0 and 1 (Fig 6)."""
+    """Hidden-state dimensionality, power, unit subsampling, decoding, PLSC of agents 0 and 1, and the tests of
+    D_eff against group size and of wideband power by context (Fig 6)."""
     a, hidden, steps = cfg.analysis, t["hidden"], t["steps"]
     rng = np.random.default_rng(a.seed)
     dims = dynamics_table(hidden, a.variance_fraction, a.spectrogram_window, a.spectrogram_overlap, cfg.env.fps)
@@ -212,7 +216,20 @@ def _dynamics(t: Tables, cfg: EfishConfig) -> Tables:
             "subsampling": subsample_table(hidden, a.subsample_fractions, a.subsample_draws, rng),
             "decoding": decode_table(hidden, steps, folds=a.decode_folds),
             "plsc": plsc_table(hidden, steps, (0, 1), a.plsc_edges_cm, a.plsc_shifts, rng, a.plsc_percentile),
-            "condition_tests": dunnett_by_measure(dims, DYNAMICS_MEASURES, "condition", control, a.seed)}
+            "condition_tests": dunnett_by_measure(dims, DYNAMICS_MEASURES, "condition", control, a.seed),
+            "size_tests": size_tests(dims), **_power(hidden, steps, dims, cfg)}
+
+
+def _power(hidden: pd.DataFrame, steps: pd.DataFrame, dims: pd.DataFrame, cfg: EfishConfig) -> Tables:
+    """Wideband power near vs far from the nearest conspecific, and its tests (Fig 6I,J); NaN rows without the
+    steps columns it needs."""
+    a = cfg.analysis
+    if lacking := _lacking(steps, ["dist_agent_cm", "size"], ["power_near_far", "power_tests"], ["power_tests"]):
+        return lacking
+    near_far = power_near_far(hidden, steps, a.claims_near_cm, a.claims_far_cm, a.spectrogram_window,
+                              a.spectrogram_overlap, cfg.env.fps)
+    return {"power_near_far": or_nan_row(near_far, "no agent-episode with a hidden state"),
+            "power_tests": power_tests(near_far, dims, steps)}
 
 
 #: The assays whose food, bites, spacing and EOD probability the behaviour analysis summarises (Figs 3-5).
@@ -230,9 +247,11 @@ ANALYSES: dict[str, Analysis] = {a.name: a for a in [
              ("size_tests",)),
     Analysis("homing", _homing, ("steps",), ("homing",),
              ("error_histogram", "error_vs_time", "trajectory_shape", "perception"), ("perception",)),
-    Analysis("onepatch", _onepatch, ("steps",), ("onepatch", "bot"), ("food_time_course", "reach_rates")),
+    Analysis("onepatch", _onepatch, ("steps",), ("onepatch", "bot"),
+             ("food_time_course", "reach_rates", "role_tests", "reach_tests"), ("role_tests", "reach_tests")),
     Analysis("dynamics", _dynamics, ("hidden", "steps"), ("patchy4", "wide2", "homing", "groupsize", "square2"),
-             ("dimensionality", "subsampling", "decoding", "plsc", "condition_tests"), ("condition_tests",)),
+             ("dimensionality", "subsampling", "decoding", "plsc", "condition_tests", "size_tests", "power_near_far",
+              "power_tests"), ("condition_tests", "size_tests", "power_tests")),
 ]}
 
 

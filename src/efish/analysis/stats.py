@@ -1,4 +1,4 @@
-"""Statistical tests as tidy rows (SPEC 12 "Tests"): Dunnett vs control, Mann-Whitney, Wilcoxon, Spearman.
+"""Statistical tests as tidy rows (SPEC 12 "Tests"): Dunnett vs control, Mann-Whitney, Wilcoxon, Spearman, Fisher.
 
 Every function returns one row per comparison with the columns of
 ``STAT_COLUMNS``: which ``test``, the ``group`` and the ``control`` it is
@@ -59,6 +59,13 @@ def _samples(df: pd.DataFrame, value: str, group: str, control) -> dict:
 def _single_nan_row(test: str, control, effect_kind: str, reason: str) -> pd.DataFrame:
     """The whole answer when there is nothing to compare: one NaN row that says why."""
     return pd.DataFrame([_row(test, np.nan, control, 0, 0, np.nan, effect_kind, reason=reason)], columns=STAT_COLUMNS)
+
+
+def nan_stat_row(reason: str, **keys) -> pd.DataFrame:
+    """One statistic row of NaNs (n = 0, stars ``n/a``) that says why there is no test, plus the ``keys`` columns
+    (e.g. ``measure``): what an analysis writes for a test its assay cannot run."""
+    return pd.DataFrame([{**{c: np.nan for c in STAT_COLUMNS}, "n": 0, "n_control": 0, "stars": "n/a",
+                          "reason": reason, **keys}])
 
 
 def _too_small(sizes: dict, minimum: int = 2) -> str:
@@ -185,3 +192,26 @@ def spearman(df: pd.DataFrame, x: str, y: str, by: str | None = None) -> pd.Data
         res = sps.spearmanr(xy[:, 0], xy[:, 1])
         rows.append(_row("spearman", g, x, len(xy), len(xy), res.statistic, "rho", res.statistic, res.pvalue))
     return pd.DataFrame(rows, columns=STAT_COLUMNS)
+
+
+def fisher_row(group, control, k: int, n: int, k_control: int, n_control: int) -> pd.DataFrame:
+    """Two-sided Fisher exact test of ``k`` successes in ``n`` trials against ``k_control`` in ``n_control``.
+
+    One row of STAT_COLUMNS: the effect is the rate difference (group minus
+    control), the statistic the sample odds ratio. NaN with a reason when a
+    group has no trial.
+    """
+    if n <= 0 or n_control <= 0:
+        return pd.DataFrame([_row("fisher", group, control, max(n, 0), max(n_control, 0), np.nan, "rate difference",
+                                  reason=f"no trials in {group if n <= 0 else control!r}")], columns=STAT_COLUMNS)
+    res = sps.fisher_exact([[k, n - k], [k_control, n_control - k_control]])
+    return pd.DataFrame([_row("fisher", group, control, n, n_control, k / n - k_control / n_control,
+                              "rate difference", res.statistic, res.pvalue)], columns=STAT_COLUMNS)
+
+
+def fisher_rates(k1: int, n1: int, k2: int, n2: int) -> tuple[float, float]:
+    """Rate difference k1/n1 - k2/n2 and the two-sided p of Fisher's exact test; ValueError for an empty group."""
+    if n1 <= 0 or n2 <= 0:
+        raise ValueError(f"an empty group ({n1} and {n2} trials)")
+    row = fisher_row("group", "control", k1, n1, k2, n2).iloc[0]
+    return float(row["effect"]), float(row["p"])

@@ -13,12 +13,11 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable
-from functools import cache
 
 import pandas as pd
 
 from .panel import Panel, Tables
-from .style import CONDITION_COLOURS, box_strip, condition_palette, mean_lines, missing, stars_for
+from .style import CONDITION_COLOURS, box_strip, condition_order, condition_palette, mean_lines, missing, stars_for
 
 #: (y-axis label, short title) of each episode_summary measure.
 MEASURES = {
@@ -30,27 +29,6 @@ MEASURES = {
 }
 #: The N-patch assay's condition names: ``iso_<n>`` (fixed total food) and ``free_<n>`` (full food per patch).
 NPATCH_CONDITION = re.compile(r"^(iso|free)_(\d+)$")
-
-
-@cache
-def assay_conditions(assay: str) -> tuple[str, ...]:
-    """The conditions of ``config/assay/<assay>.yaml`` in their listed order (the first is the control)."""
-    import yaml
-
-    from ..config import config_dir
-
-    path = config_dir() / "assay" / f"{assay}.yaml"
-    if not path.is_file():
-        raise ValueError(f"no assay config {path} to order the conditions of {assay!r}")
-    return tuple((yaml.safe_load(path.read_text()).get("assay") or {}).get("conditions") or ())
-
-
-def condition_order(assay: str, present, control=None) -> list:
-    """Conditions present in a table: ``control`` first, then the assay config's order, then any others sorted."""
-    present = list(dict.fromkeys(present))
-    listed = [c for c in assay_conditions(assay) if c in present]
-    order = listed + sorted((c for c in present if c not in listed), key=str)
-    return [control, *(c for c in order if c != control)] if control in present else order
 
 
 def dunnett_stars(tests: pd.DataFrame, measure: str, groups) -> dict:

@@ -13,19 +13,19 @@ colour of "A < B".
 from __future__ import annotations
 
 from collections.abc import Callable
-from functools import lru_cache
 
 import numpy as np
 import pandas as pd
 
+from ..analysis.onepatch import SOCIAL
 from ..config import EfishConfig
-from ..config.compose import compose_variants
 from .panel import Panel
 from .style import (
     NEUTRAL_COLOUR,
     ONEPATCH_CLASS_COLOURS,
     agent_colour,
     annotate_stars,
+    assay_conditions,
     box_strip,
     finite,
     missing,
@@ -49,12 +49,6 @@ DARK_GREY = "#404040"
 
 
 # ------------------------------------------------------------------ configs
-@lru_cache(maxsize=4)
-def assay_conditions(assay: str) -> dict[str, EfishConfig]:
-    """The composed config of every condition of ``assay`` (cached: Hydra composes once per assay)."""
-    return compose_variants([f"assay={assay}"], None, "condition")
-
-
 def onepatch_roles() -> dict[str, dict[str, int]]:
     """Per one-patch condition: role letter ("A", "B") -> agent index, from each condition's ``env.roles``."""
     return {cond: {ROLE_LETTERS[r]: i for i, r in enumerate(cfg.env.roles) if r in ROLE_LETTERS}
@@ -233,9 +227,14 @@ def food_by_role(role: str) -> Callable[[Tables, object], None]:
         if not order:
             missing(ax, f"no agent of role {role} in the onepatch food table")
             return
+        tests = tables["tests"]
+        tests = tests[tests["role"] == role] if "role" in tests.columns else tests.iloc[:0]
+        # B: each social condition vs B alone; A: the social conditions pooled vs A alone (onepatch role_tests)
+        stars = ({c: stars_for(tests, group=c) for c in order if c in SOCIAL} if role == "B"
+                 else {f"{role}_alone": f"vs social: {stars_for(tests, group='social')}"})
         box_strip(ax, rows.assign(condition=rows["condition"].astype(str)), "condition", "food_eaten", order,
                   {c: ONEPATCH_CLASS_COLOURS.get(c, NEUTRAL_COLOUR) for c in order},
-                  labels={c: _class_label(c) for c in order})
+                  stars=stars, labels={c: _class_label(c) for c in order})
         ax.set_xlabel("size class of A vs B, or alone")
         ax.set_ylabel(f"food eaten by {role} (pellets / episode)")
         ax.set_title(f"Food of {role}: social vs alone")
@@ -312,7 +311,11 @@ def bot_reach(contrast: str) -> Callable[[Tables, object], None]:
         ax.set_xticks([centre, centre + len(classes) + 1], names)
         labels = rows.drop_duplicates("size_class").set_index("size_class")["class_label"]
         _class_legend(ax, classes, [labels[c] for c in classes])
-        ax.set_ylim(-0.05, 1.1)
+        # one bracket over the two groups: the onepatch analysis's Fisher exact test of the pooled counts
+        tests = tables["tests"]
+        stars = stars_for(tests[tests["contrast"] == contrast] if "contrast" in tests.columns else tests.iloc[:0])
+        annotate_stars(ax, centre, 1.12, stars, x2=centre + len(classes) + 1)
+        ax.set_ylim(-0.05, 1.3)
         ax.set_xlabel(xlabel)
         ax.set_ylabel("B reached the patch (fraction)")
         ax.set_title("Bot frozen vs moving" if contrast == "mobility" else "Bot EOD silent vs on")
@@ -443,7 +446,8 @@ _FOOD = "analysis/behaviour/onepatch/food_per_agent.parquet"
 _COURSE = "analysis/onepatch/onepatch/food_time_course.parquet"
 _REACH = "analysis/onepatch/bot/reach_rates.parquet"
 _PAIRS = "analysis/interactions/square2"
-_MISSING_TEST = "No test is drawn: no analysis table holds it (see the figures issue)."
+_ROLE_TESTS = "analysis/onepatch/onepatch/role_tests.parquet"
+_REACH_TESTS = "analysis/onepatch/bot/reach_tests.parquet"
 
 PANELS: list[Panel] = [
     Panel("fig5", "A", assay_scene,
@@ -454,24 +458,28 @@ PANELS: list[Panel] = [
             f"Paths of A and B in the first {_class_label(cond)} episode of the onepatch assay (steps table); "
             "o marks the start, * each pellet eaten; dashed circle: the patch.")
       for letter, cond in zip("BCD", TRAJECTORY_CONDITIONS, strict=True)],
-    Panel("fig5", "E", food_by_role("B"), {"food": _FOOD},
+    Panel("fig5", "E", food_by_role("B"), {"food": _FOOD, "tests": _ROLE_TESTS},
           "Food eaten per episode by the intruder B in each size class and alone (onepatch, behaviour "
-          "food_per_agent); box and every episode. " + _MISSING_TEST),
-    Panel("fig5", "F", food_by_role("A"), {"food": _FOOD},
+          "food_per_agent); box and every episode. Stars: Mann-Whitney of B's food in each social condition vs B "
+          "alone (onepatch role_tests, role B)."),
+    Panel("fig5", "F", food_by_role("A"), {"food": _FOOD, "tests": _ROLE_TESTS},
           "Food eaten per episode by the resident A in each size class and alone (onepatch, behaviour "
-          "food_per_agent); box and every episode. " + _MISSING_TEST),
+          "food_per_agent); box and every episode. Stars over A alone: Mann-Whitney of A's food, social conditions "
+          "pooled, vs A alone (onepatch role_tests, role A)."),
     Panel("fig5", "G", food_course_by_role("B"), {"course": _COURSE},
           "Cumulative food of B over time, mean +- SEM over episodes, per size class and alone (onepatch, "
           "onepatch food_time_course)."),
     Panel("fig5", "H", food_course_by_role("A"), {"course": _COURSE},
           "Cumulative food of A over time, mean +- SEM over episodes, per size class and alone (onepatch, "
           "onepatch food_time_course)."),
-    Panel("fig5", "I", bot_reach("mobility"), {"reach": _REACH},
+    Panel("fig5", "I", bot_reach("mobility"), {"reach": _REACH, "tests": _REACH_TESTS},
           "Fraction of episodes in which the trained agent B reached the patch, bot frozen vs moving, per size "
-          "pair; each point one bot EOD rate (bot assay, onepatch reach_rates). " + _MISSING_TEST),
-    Panel("fig5", "J", bot_reach("eod"), {"reach": _REACH},
+          "pair; each point one bot EOD rate (bot assay, onepatch reach_rates). Stars: Fisher exact test of B's "
+          "reach counts pooled over sizes and rates, frozen vs moving (onepatch reach_tests, contrast mobility)."),
+    Panel("fig5", "J", bot_reach("eod"), {"reach": _REACH, "tests": _REACH_TESTS},
           "Fraction of episodes in which B reached the patch, bot silent (EOD rate 0) vs discharging (rates "
-          "0.25-1), per size pair; each point one bot condition (bot assay, onepatch reach_rates). " + _MISSING_TEST),
+          "0.25-1), per size pair; each point one bot condition (bot assay, onepatch reach_rates). Stars: Fisher "
+          "exact test of B's pooled reach counts, emitting vs silent (onepatch reach_tests, contrast eod)."),
     Panel("fig5", "K", size_difference("chase"),
           {"events": f"{_PAIRS}/chase_sizes.parquet", "tests": f"{_PAIRS}/size_tests.parquet"},
           "Chaser minus chased body size per chasing bout (square2, interactions chase_sizes), with the median "

@@ -3,11 +3,12 @@
 Panels read the dynamics analysis (``analysis/dynamics/<assay>/``):
 ``dimensionality`` (D_eff, PCs for the variance fraction and wideband power
 per agent-episode), ``subsampling`` (D_eff of random unit subsets),
-``decoding`` (cross-validated score per target) and ``plsc`` (per distance
-bin). Where the analysis does not yet write what a panel needs (the PCA
-variance spectrum, decoding split by food distance, power split by the
-conspecific's distance, the trend and pair tests), the panel draws what there
-is and its caption, or the panel itself, says what is missing.
+``decoding`` (cross-validated score per target), ``plsc`` (per distance
+bin), ``power_near_far`` and the statistic tables ``size_tests`` (D_eff
+against N) and ``power_tests`` (near vs far, smaller vs larger), whose stars
+the panels draw. Where the analysis does not yet write what a panel needs (the
+PCA variance spectrum, decoding split by food distance), the panel draws what
+there is and its caption, or the panel itself, says what is missing.
 """
 
 from __future__ import annotations
@@ -17,18 +18,21 @@ import re
 import numpy as np
 import pandas as pd
 
+from ..analysis.dynamics_tests import smaller_larger
 from ..config.schema import AnalysisConfig
-from .fig4 import condition_order
 from .panel import Panel, Tables
 from .style import (
     NEUTRAL_COLOUR,
     RECEPTOR_COLOURS,
+    annotate_stars,
     box_strip,
+    condition_order,
     condition_palette,
     group_size_colours,
     mean_lines,
     missing,
     size_class_colours,
+    stars_for,
 )
 
 #: The groupsize assay's condition names: ``n<N>_K`` (Knollenorgans on) and ``n<N>_noK`` (off).
@@ -76,10 +80,18 @@ def deff_vs_group_size(tables: Tables, ax) -> None:
     """Panel B: D_eff per agent-episode against group size, Knollenorgans on and off (mean +- SEM)."""
     frame = groupsize_frame(tables["dims"])
     if mean_lines(ax, frame, "n_agents", "d_eff", "knollenorgans", KNOLLENORGAN_COLOURS, KNOLLENORGAN_STYLES):
+        # the dynamics analysis's Spearman of D_eff against N per Knollenorgan state (size_tests; group K / noK)
+        tests = tables["tests"]
+        notes = []
+        for key, state in KNOLLENORGAN_STATE.items():
+            row = tests[tests["group"] == key]
+            rho = float(row["effect"].iloc[0]) if len(row) else np.nan
+            notes.append(f"{state}: " + (f"rho {rho:+.2f} " if np.isfinite(rho) else "") + stars_for(row))
+        ax.text(0.02, 0.98, "\n".join(notes), transform=ax.transAxes, va="top", fontsize=6)
         ax.set_xlabel("group size N (agents)")
         ax.set_ylabel("D_eff of the hidden state")
         ax.set_title("Dimensionality vs group size")
-        ax.legend(loc="best")
+        ax.legend(loc="lower right")
 
 
 def subsampling_curves(tables: Tables, ax) -> None:
@@ -184,17 +196,39 @@ def plsc_bars(column: str, ylabel: str, title: str, integer: bool = False):
     return draw
 
 
+def _pair_bracket(ax, frame: pd.DataFrame, y: str, tests: pd.DataFrame, measure: str) -> None:
+    """A bracket over the two boxes with the stars of the ``measure`` row of a dynamics statistic table."""
+    top = float(np.nanmax(pd.to_numeric(frame[y], errors="coerce")))
+    row = tests[tests["measure"] == measure] if "measure" in tests.columns else tests.iloc[:0]
+    annotate_stars(ax, 0, top * 1.08, stars_for(row), x2=1)
+    ax.set_ylim(top=top * 1.3)
+
+
+def power_near_far(tables: Tables, ax) -> None:
+    """Panel I: wideband power of each agent-episode over its steps with the conspecific near vs far, pairs joined,
+    with the Wilcoxon stars of power_tests."""
+    frame, order = tables["power"], ["near", "far"]
+    if not box_strip(ax, frame, "where", "wideband_power", order, condition_palette(order)):
+        return
+    wide = frame.pivot_table(index=["condition", "episode", "agent"], columns="where", values="wideband_power")
+    wide = wide.reindex(columns=order).dropna()
+    ax.plot([0, 1], wide.to_numpy(float).T, color=NEUTRAL_COLOUR, lw=0.3, alpha=0.5, zorder=1)
+    _pair_bracket(ax, frame, "wideband_power", tables["tests"], "near_far")
+    a = AnalysisConfig()
+    ax.set_xticks([0, 1], [f"near (<= {a.claims_near_cm:g} cm)", f"far (> {a.claims_far_cm:g} cm)"])
+    ax.set_xlabel("nearest conspecific (wide2)")
+    ax.set_ylabel(POWER_LABEL)
+    ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 3))
+    ax.set_title("Power vs conspecific distance")
+
+
 def power_by_size(tables: Tables, ax) -> None:
-    """Panel J: wideband power of the agent below vs above its episode's median size (equal sizes dropped)."""
-    dims, episodes = tables["dims"], tables["episodes"]
-    keys = ["condition", "episode", "agent"]
-    frame = dims.merge(episodes[[*keys, "size"]], on=keys, how="left")
-    median = frame.groupby(["condition", "episode"])["size"].transform("median")
-    frame = frame.assign(size_class=np.select([frame["size"] < median, frame["size"] > median],
-                                              ["smaller", "larger"], ""))
+    """Panel J: wideband power of the smallest agent of each episode vs the others (equal sizes dropped), with the
+    Mann-Whitney stars of power_tests."""
+    frame = smaller_larger(tables["dims"], tables["episodes"])
     order = ["smaller", "larger"]
-    if box_strip(ax, frame, "size_class", "wideband_power", order, dict(zip(order, size_class_colours(2),
-                                                                             strict=True))):
+    if box_strip(ax, frame, "role", "wideband_power", order, dict(zip(order, size_class_colours(2), strict=True))):
+        _pair_bracket(ax, frame, "wideband_power", tables["tests"], "size")
         ax.set_xlabel("agent within its episode (wide2)")
         ax.set_ylabel(POWER_LABEL)
         ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 3))
@@ -211,10 +245,11 @@ PANELS = [
           "normalised PCA variances) and the number of PCs reaching analysis.variance_fraction of the variance, "
           "from analysis/dynamics/patchy4/dimensionality. The cumulative-variance curve itself needs the PCA "
           "variance spectrum, which no analysis table holds yet."),
-    Panel("fig6", "B", deff_vs_group_size, {"dims": _dyn("groupsize", "dimensionality")},
+    Panel("fig6", "B", deff_vs_group_size, {"dims": _dyn("groupsize", "dimensionality"),
+                                            "tests": _dyn("groupsize", "size_tests")},
           "D_eff of the hidden state per agent-episode against group size N, Knollenorgans on (solid) and off "
-          "(dashed), mean +- SEM, groupsize assay, analysis/dynamics/groupsize/dimensionality. No trend test: the "
-          "Spearman of D_eff against N per Knollenorgan state is not in any analysis table."),
+          "(dashed), mean +- SEM, groupsize assay, analysis/dynamics/groupsize/dimensionality; rho and stars: "
+          "Spearman of D_eff against N over agent-episodes per Knollenorgan state (dynamics size_tests)."),
     Panel("fig6", "C", subsampling_curves, {"subsampling": _dyn("groupsize", "subsampling")},
           "D_eff of random subsets of hidden units (analysis.subsample_fractions of the units, "
           "analysis.subsample_draws draws each) against the fraction kept, mean over draws and agent-episodes, per "
@@ -243,14 +278,16 @@ PANELS = [
           "Number of PLSC components whose singular value and score correlation both exceed the "
           "analysis.plsc_percentile of a circular-shift null (counted until the first failure), per pair-distance "
           "bin of the wide2 assay, analysis/dynamics/wide2/plsc."),
-    Panel("fig6", "I", needs_analysis("no near / far split of wideband power\nin analysis/dynamics/wide2"),
-          {"dims": _dyn("wide2", "dimensionality")},
-          "Wideband power with the conspecific near vs far (wide2): the dynamics analysis computes power per "
-          "agent-episode only, not per distance, so the panel says so instead of drawing."),
+    Panel("fig6", "I", power_near_far, {"power": _dyn("wide2", "power_near_far"), "tests": _dyn("wide2", "power_tests")},
+          "Wideband power of the hidden state (spectrogram, analysis.spectrogram_window-step windows) of each "
+          "agent-episode of the wide2 assay over its steps with the nearest conspecific within analysis."
+          "claims_near_cm vs beyond analysis.claims_far_cm, pairs joined (dynamics power_near_far); stars: Wilcoxon "
+          "signed-rank far vs near over agent-episodes (dynamics power_tests, measure near_far)."),
     Panel("fig6", "J", power_by_size, {"dims": _dyn("wide2", "dimensionality"),
-                                       "episodes": "assays/wide2/episodes.parquet"},
-          "Wideband power of the hidden state (spectrogram, analysis.spectrogram_window-step windows) per "
-          "agent-episode of the wide2 assay, the smaller vs the larger agent of each episode (sizes from the "
-          "episodes table), analysis/dynamics/wide2/dimensionality. No stars: the Mann-Whitney test of smaller vs "
-          "larger is not in any analysis table."),
+                                       "episodes": "assays/wide2/episodes.parquet",
+                                       "tests": _dyn("wide2", "power_tests")},
+          "Wideband power of the hidden state per agent-episode of the wide2 assay, the smallest agent of each "
+          "episode vs the others (sizes from the episodes table; episodes of equal sizes left out), "
+          "analysis/dynamics/wide2/dimensionality; stars: Mann-Whitney smaller vs larger (dynamics power_tests, "
+          "measure size)."),
 ]

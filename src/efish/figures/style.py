@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from contextlib import contextmanager
+from functools import lru_cache
 
 import numpy as np
 import pandas as pd
@@ -200,3 +201,25 @@ def mean_lines(ax, data: pd.DataFrame, x: str, y: str, hue: str, palette: dict, 
 
 #: Food pellets wherever they are drawn (episode clips, scenes): brown, apart from every agent colour.
 PELLET_COLOUR = "#8c564b"
+
+
+# ------------------------------------------- assay conditions: configs and display order
+@lru_cache(maxsize=8)
+def assay_conditions(assay: str) -> dict:
+    """The composed config of every condition of ``config/assay/<assay>.yaml``, in the listed order (the first
+    is the control). Cached: Hydra composes once per assay; panels of Figs 4-6 read roles, sizes and order here."""
+    from ..config import config_dir
+    from ..config.compose import compose_variants
+
+    if not (config_dir() / "assay" / f"{assay}.yaml").is_file():
+        raise ValueError(f"no assay config {config_dir() / 'assay' / f'{assay}.yaml'} to read the conditions of "
+                         f"{assay!r}")
+    return compose_variants([f"assay={assay}"], None, "condition")
+
+
+def condition_order(assay: str, present, control=None) -> list:
+    """Conditions present in a table: ``control`` first, then the assay config's order, then any others sorted."""
+    present = list(dict.fromkeys(present))
+    listed = [c for c in assay_conditions(assay) if c in present]
+    order = listed + sorted((c for c in present if c not in listed), key=str)
+    return [control, *(c for c in order if c != control)] if control in present else order

@@ -1,0 +1,97 @@
+"""Tests on the hidden-state dynamics (SPEC 12; Fig 6B, I, J): D_eff against group size, wideband power by context.
+
+The dynamics analysis writes them as statistic tables (columns of
+:data:`efish.analysis.stats.STAT_COLUMNS` plus ``measure``): ``size_tests``
+(Spearman of D_eff against the group size N of ``config/assay/groupsize.yaml``,
+whose conditions are named ``n<N>_K`` / ``n<N>_noK``, separately with
+Knollenorgans on and off) and ``power_tests`` (wideband power with the nearest
+conspecific near vs far, Wilcoxon over agent-episodes; of the smallest agent of
+an episode vs the others, Mann-Whitney). Fig 6 and the claims C17 and C21 read
+these rows.
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pandas as pd
+
+from ._tables import AGENT_EPISODE, EPISODE, agent_sizes, require
+from .dynamics import _with_steps, degenerate_reason, units, wideband_power
+from .stats import mann_whitney, nan_stat_row, spearman, wilcoxon_paired
+
+#: A groupsize condition: group size N and Knollenorgans on (``K``) or off (``noK``).
+GROUPSIZE_CONDITION = re.compile(r"^n(\d+)_(K|noK)$")
+NEAR_FAR_COLUMNS = [*AGENT_EPISODE, "where", "n_steps", "wideband_power", "reason"]
+
+
+def groupsize_parts(table: pd.DataFrame) -> pd.DataFrame:
+    """The rows of groupsize conditions with ``n_agents`` (N) and ``knollenorgans`` (``K`` or ``noK``)."""
+    require(table, ["condition"], "table")
+    parts = table["condition"].astype(str).str.extract(GROUPSIZE_CONDITION)
+    keep = parts[0].notna().to_numpy()
+    return table[keep].assign(n_agents=pd.to_numeric(parts[0][keep]).astype(int), knollenorgans=parts[1][keep])
+
+
+def size_tests(dims: pd.DataFrame) -> pd.DataFrame:
+    """Spearman rho of D_eff against group size N over agent-episodes, one row per Knollenorgan state (group K, noK).
+
+    ``dims``: the dimensionality table (:func:`efish.analysis.dynamics.dynamics_table`).
+    An assay without groupsize conditions gets one NaN row that says so.
+    """
+    require(dims, ["condition", "d_eff"], "dimensionality table")
+    frame = groupsize_parts(dims)
+    if frame.empty:
+        return nan_stat_row("no groupsize condition (n<N>_K or n<N>_noK)", measure="d_eff")
+    return spearman(frame, "n_agents", "d_eff", by="knollenorgans").assign(measure="d_eff")
+
+
+def power_near_far(hidden: pd.DataFrame, steps: pd.DataFrame, near_cm: float, far_cm: float, window: int,
+                   overlap: int, fs: float) -> pd.DataFrame:
+    """Wideband power per agent-episode over its steps with the nearest conspecific near (<= ``near_cm``) and far
+    (> ``far_cm``): one row per agent-episode and ``where``; NaN power (with a reason) when too few steps."""
+    if far_cm < near_cm:
+        raise ValueError(f"far_cm ({far_cm}) must not be below near_cm ({near_cm})")
+    j, h = _with_steps(hidden, steps, ["dist_agent_cm"]), units(hidden)
+    rows = []
+    for keys, sub in j.groupby(AGENT_EPISODE, sort=True):
+        d = sub["dist_agent_cm"].to_numpy(np.float64)
+        x = sub[h].to_numpy(np.float64)  # rows in t order (_with_steps sorts)
+        for where, keep in (("near", d <= near_cm), ("far", d > far_cm)):
+            rows.append({**dict(zip(AGENT_EPISODE, keys, strict=True)), "where": where, "n_steps": int(keep.sum()),
+                         "wideband_power": wideband_power(x[keep], window, overlap, fs),
+                         "reason": (f"only {keep.sum()} {where} steps, fewer than the {window}-step spectrogram "
+                                    "window" if keep.sum() < window else degenerate_reason(x[keep], window))})
+    return pd.DataFrame(rows, columns=NEAR_FAR_COLUMNS)
+
+
+def smaller_larger(dims: pd.DataFrame, steps: pd.DataFrame) -> pd.DataFrame:
+    """The dimensionality rows with ``role`` ``smaller`` (the smallest agent of its episode) or ``larger``;
+    episodes whose agents all have one size are left out."""
+    d = dims.drop(columns="size", errors="ignore").merge(agent_sizes(steps).rename("size").reset_index(),
+                                                         on=AGENT_EPISODE)
+    by = d.groupby(EPISODE)["size"]
+    mixed = (by.transform("nunique") > 1).to_numpy()
+    role = np.where(by.rank(method="min") == 1, "smaller", "larger")
+    return d.assign(role=role)[mixed]
+
+
+def power_tests(near_far: pd.DataFrame, dims: pd.DataFrame, steps: pd.DataFrame) -> pd.DataFrame:
+    """Wideband power far minus near (Wilcoxon, paired by agent-episode; measure ``near_far``) and smaller minus
+    larger agent (Mann-Whitney over agent-episodes; measure ``size``)."""
+    require(dims, [*AGENT_EPISODE, "wideband_power"], "dimensionality table")
+    out = []
+    pairs = near_far.dropna(subset=["wideband_power"])
+    if set(pairs["where"]) >= {"near", "far"}:
+        out.append(wilcoxon_paired(pairs, "wideband_power", "where", "near", AGENT_EPISODE).assign(measure="near_far"))
+    else:
+        out.append(nan_stat_row("no agent-episode with enough near and far steps for a spectrogram", group="far",
+                            control="near", measure="near_far"))
+    roles = smaller_larger(dims, steps).dropna(subset=["wideband_power"])
+    if set(roles["role"]) >= {"smaller", "larger"}:
+        out.append(mann_whitney(roles, "wideband_power", "role", "larger").assign(measure="size"))
+    else:
+        out.append(nan_stat_row("no episode with agents of different sizes and a finite wideband power",
+                            group="smaller", control="larger", measure="size"))
+    return pd.concat(out, ignore_index=True)

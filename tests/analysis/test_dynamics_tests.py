@@ -1,0 +1,82 @@
+"""The dynamics analysis's statistic tables: D_eff against group size by Knollenorgan state (size_tests) and
+wideband power near vs far and smaller vs larger (power_tests), on data with the effect built in."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy import stats as sps
+
+from efish.analysis.dynamics_tests import groupsize_parts, power_near_far, power_tests, size_tests
+from efish.analysis.stats import STAT_COLUMNS
+
+
+def test_groupsize_parts_parse_n_and_knollenorgans_and_drop_others():
+    parts = groupsize_parts(pd.DataFrame({"condition": ["n2_K", "n8_noK", "control", "n3_Kx"]}))
+    assert parts["n_agents"].tolist() == [2, 8] and parts["knollenorgans"].tolist() == ["K", "noK"]
+
+
+def test_size_tests_find_d_eff_rising_with_n_only_with_knollenorgans():
+    rng = np.random.default_rng(0)
+    rows = []
+    for n in (1, 2, 4, 8):
+        rows += [{"condition": f"n{n}_K", "episode": e, "agent": 0, "d_eff": n + rng.normal(0, 0.1)} for e in range(6)]
+        rows += [{"condition": f"n{n}_noK", "episode": e, "agent": 0, "d_eff": rng.normal(3, 1)} for e in range(6)]
+    dims = pd.DataFrame(rows)
+    table = size_tests(dims)
+    assert list(table.columns[: len(STAT_COLUMNS)]) == STAT_COLUMNS and set(table["measure"]) == {"d_eff"}
+    tests = table.set_index("group")
+    k = dims[dims["condition"].str.endswith("_K")]
+    expected = sps.spearmanr(k["condition"].str.extract(r"n(\d+)")[0].astype(int), k["d_eff"])
+    assert tests.loc["K", "effect"] == pytest.approx(expected.statistic)
+    assert tests.loc["K", "p"] == pytest.approx(expected.pvalue) and tests.loc["K", "p"] < 1e-4
+    assert tests.loc["noK", "p"] > 0.01 and tests.loc["K", "control"] == "n_agents" and tests.loc["K", "n"] == 24
+    other = size_tests(pd.DataFrame({"condition": ["control"], "d_eff": [2.0]}))
+    assert len(other) == 1 and np.isnan(other["p"].item()) and "groupsize" in other["reason"].item()
+
+
+def pair(episodes: int = 8, steps: int = 120, loud_far: float = 3.0):
+    """Two agents whose distance is 5 cm in the first half and 150 cm in the second; the hidden states are noise
+    ``loud_far`` times larger when far apart; agent 0 is smaller and twice as loud throughout."""
+    rng = np.random.default_rng(1)
+    far = np.arange(steps) >= steps // 2
+    frames, hidden = [], []
+    for e in range(episodes):
+        for agent, size in ((0, 0.3), (1, 0.7)):
+            keys = {"condition": "control", "episode": e, "agent": agent, "t": np.arange(steps)}
+            frames.append(pd.DataFrame({**keys, "dist_agent_cm": np.where(far, 150.0, 5.0), "size": size}))
+            scale = np.where(far, loud_far, 1.0)[:, None] * (2.0 if agent == 0 else 1.0)
+            hidden.append(pd.DataFrame({**keys, **{f"h_{i}": v for i, v in
+                                                  enumerate((rng.normal(0, 1, (steps, 4)) * scale).T)}}))
+    return pd.concat(hidden, ignore_index=True), pd.concat(frames, ignore_index=True)
+
+
+def test_power_near_far_and_its_tests_find_the_built_in_effects():
+    hidden, steps = pair()
+    near_far = power_near_far(hidden, steps, 10.0, 100.0, 20, 10, 50.0)
+    assert len(near_far) == 8 * 2 * 2 and (near_far["n_steps"] == 60).all() and (near_far["reason"] == "").all()
+    wide = near_far.pivot(index=["episode", "agent"], columns="where", values="wideband_power")
+    assert (wide["far"] / wide["near"]).between(9 * 0.5, 9 * 2).all()  # power scales with amplitude squared
+    dims = near_far.groupby(["condition", "episode", "agent"], as_index=False)["wideband_power"].mean()
+    tests = power_tests(near_far, dims, steps).set_index("measure")
+    nf = tests.loc["near_far"]
+    assert (nf["test"], nf["group"], nf["control"], nf["n"]) == ("wilcoxon", "far", "near", 16)
+    assert nf["effect"] == pytest.approx(np.median(wide["far"] - wide["near"]))
+    assert nf["p"] < 0.001
+    size = tests.loc["size"]
+    assert (size["test"], size["group"], size["control"], size["n"], size["n_control"]) == (
+        "mann-whitney", "smaller", "larger", 8, 8)
+    assert size["effect"] > 0 and size["p"] < 0.001
+
+
+def test_power_tests_say_why_without_far_steps_or_size_differences():
+    hidden, steps = pair()
+    near_far = power_near_far(hidden, steps.assign(dist_agent_cm=5.0, size=0.5), 10.0, 100.0, 20, 10, 50.0)
+    assert near_far.loc[near_far["where"] == "far", "reason"].eq("only 0 far steps, fewer than the 20-step spectrogram window").all()
+    dims = near_far.groupby(["condition", "episode", "agent"], as_index=False)["wideband_power"].first()
+    tests = power_tests(near_far, dims, steps.assign(size=0.5)).set_index("measure")
+    assert tests["p"].isna().all()
+    assert "near and far" in tests.loc["near_far", "reason"] and "sizes" in tests.loc["size", "reason"]
+    with pytest.raises(ValueError, match="far_cm"):
+        power_near_far(hidden, steps, 100.0, 10.0, 20, 10, 50.0)
