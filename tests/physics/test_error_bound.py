@@ -40,7 +40,7 @@ def random_large_batch(seed: int) -> SnapshotBatch:
 @pytest.mark.parametrize("overrides", [(), ("sensors.mormyromast.g_self=0",), ("physics.image_order=2",)],
                          ids=["default", "cons-only", "order2"])
 def test_measured_error_never_exceeds_the_reported_bound(seed, overrides):
-    cfg = cfg_with(*overrides)
+    cfg = cfg_with("physics.error_bound=true", *overrides)
     batch = random_large_batch(seed)
     plan, exact_plan = build_plan(cfg), build_plan(cfg, tolerance=0.0)
     raw, exact = fast_raw(batch, plan), fast_raw(batch, exact_plan)
@@ -65,8 +65,16 @@ def test_measured_error_never_exceeds_the_reported_bound(seed, overrides):
 
 def test_tolerance_zero_reports_a_zero_bound():
     batch = random_large_batch(0)
-    plan = build_plan(cfg_with(), tolerance=0.0)
+    plan = build_plan(cfg_with("physics.error_bound=true"), tolerance=0.0)
     assert np.all(fast_raw(batch, plan).error_bound == 0)
+
+
+def test_the_bound_is_only_computed_when_asked():
+    batch = random_large_batch(2).select(slice(0, 1))
+    plan = build_plan(cfg_with())
+    assert not plan.on("error_bound") and fast_raw(batch, plan).error_bound is None
+    with pytest.raises(ValueError, match="no error bound"):
+        normalised_error_bound(fast_raw(batch, plan), plan)
 
 
 def test_the_reference_carries_no_bound_to_normalise():

@@ -59,6 +59,9 @@ class PhysicsConfig:
     induction: bool = param(True, "bodies are polarised by EOD fields (induced dipoles)")
     tolerance: float = param(1e-7, "skip a source when a bound on its field is below tolerance * E_min; 0 = exact", lo=0.0, hi=1e3)
     dtype: str = param("float64", "floating type of the field kernels", choices=("float64", "float32"))
+    error_bound: bool = param(False, "report a bound of every Mormyromast and Ampullary reading's error "
+                              "(RawReadings.error_bound); off by default: it adds about 15% to sensing time",
+                              neutral=True)
     far_field_levels: list = param([13, 31], "point counts (odd, increasing) a distant source may be interpolated "
                                    "from; the first is evaluated densely over all sources; [] = off")
     far_field_min_cm: float = param(3.0, "sources closer than this are always evaluated at every sensor, cm", lo=1.0)

@@ -44,6 +44,7 @@ def kernel_constants(plan: EffectPlan) -> tuple[np.ndarray, np.ndarray]:
     f[kn.DO_WALLDIST] = plan.on("wall_distortion")
     f[kn.DO_PELLETS] = plan.on("pellets")
     f[kn.CULL] = plan.tolerance > 0
+    f[kn.ERROR_BOUND] = plan.on("error_bound")
     return c.astype(dtype), f
 
 
@@ -78,7 +79,8 @@ def fast_raw(batch: SnapshotBatch, plan: EffectPlan) -> RawReadings:
     dtype = np.dtype(plan.dtype)
     b, n, _ = batch.shape
     out = empty_readings(b, n, plan, dtype)
-    out.error_bound = np.zeros((b, n, 2))  # the kernel fills it; all zero when no field is computed
+    error_bound = np.zeros((b, n, 2))  # the kernel fills it when asked; all zero when no field is computed
+    out.error_bound = error_bound if plan.on("error_bound") else None
     if not plan.on("fields"):
         return out
     tables = prepared_inputs(plan)
@@ -96,6 +98,6 @@ def fast_raw(batch: SnapshotBatch, plan: EffectPlan) -> RawReadings:
         emitting=np.ascontiguousarray(batch.agent_emitting & plan.on("eod_emission")),
         pellet_xy=arr(batch.pellet_xy, CM), pellet_phi=arr(batch.pellet_orientation),
         pellet_alive=np.ascontiguousarray(batch.pellet_alive), width=arr(batch.width, CM), height=arr(batch.height, CM))
-    outputs = Outputs(out.mormyromast, out.ampullary, out.knollenorgan, out.error_bound)
+    outputs = Outputs(out.mormyromast, out.ampullary, out.knollenorgan, error_bound)
     sense_batch_kernel(tuple(arrays), tuple(tables), tuple(outputs))  # plain tuples pass faster, see the kernel
     return out

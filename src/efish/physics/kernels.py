@@ -25,7 +25,7 @@ K, Q, HALF_SEP, P_AGENT, P_PELLET, ALPHA_AGENT, ALPHA_PELLET, SOFT2, R_SENS = ra
 TOL_MORM, TOL_AMP, ZERO_MORM, ZERO_AMP, KNOLL_ZERO, G_SELF, G_CONS, K_CONS = range(9, 17)
 ONE, TWO, THREE, ZERO, FAR_MAX_LX, FAR_MAX_LS, N_CONSTS = 17, 18, 19, 20, 21, 22, 23
 # Indices into the ``flags`` array.
-DO_MORM, DO_AMP, DO_KNOLL, DO_INDUCTION, DO_WALLDIST, DO_PELLETS, CULL, N_FLAGS = range(8)
+DO_MORM, DO_AMP, DO_KNOLL, DO_INDUCTION, DO_WALLDIST, DO_PELLETS, CULL, ERROR_BOUND, N_FLAGS = range(9)
 # Columns of the source list built per agent: position, Mormyromast moment, Ampullary moment.
 SX, SY, M1X, M1Y, M2X, M2Y, N_SRC = range(7)
 

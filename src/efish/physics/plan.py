@@ -191,6 +191,9 @@ def build_plan(cfg: EfishConfig, scene: Scene | None = None, *, tolerance: float
         Effect("far_field", electric and tol > 0 and len(ph.far_field_levels) > 0,
                f"distant sources interpolated from {list(ph.far_field_levels)} points on the sensor circle"
                if tol > 0 and ph.far_field_levels else "off: " + ("tolerance 0" if tol == 0 else "physics.far_field_levels is empty")),
+        Effect("error_bound", electric and ph.error_bound,
+               "each reading's error bound is summed over culled and interpolated sources" if ph.error_bound
+               else "off: physics.error_bound is false"),
     )
     k = coulomb_constant(ph.eps0)
     order = ph.image_order if walls else 0

@@ -19,7 +19,7 @@ class RawReadings:
     ampullary: float[B, N, 24]
     knollenorgan: float[B, N, N-1, 12]  # slot j = j-th other agent in id order
     morm_self, morm_cons: float[B, N, 36] or None  # ungated parts (reference only)
-    error_bound: float64[B, N, 2] or None  # fast path: bound of |reading - exact| of every Mormyromast
+    error_bound: float64[B, N, 2] or None  # fast path with physics.error_bound: bound of |reading - exact| of every Mormyromast
         # (column 0) and Ampullary (1) reading of an agent, V/m (0 at tolerance 0: exact to round-off)
     """
 
@@ -40,7 +40,9 @@ def normalised_error_bound(raw: RawReadings, plan: EffectPlan) -> np.ndarray:
     largest factor noise can draw, bounds the normalised error with or without noise.
     """
     if raw.error_bound is None:
-        raise ValueError("these readings carry no error bound (the reference is exact; use the fast path)")
+        raise ValueError("these readings carry no error bound: the fast path reports one with "
+                         "physics.error_bound=true (the reference is exact)")
+
     def lipschitz(lo: float, hi: float, noise: float) -> float:
         return noise / (lo * np.log(10) * np.log10(hi / lo))
 

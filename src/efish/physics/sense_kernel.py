@@ -55,6 +55,7 @@ from .kernels import (
     DO_MORM,
     DO_PELLETS,
     DO_WALLDIST,
+    ERROR_BOUND,
     G_CONS,
     G_SELF,
     HALF_SEP,
@@ -241,7 +242,7 @@ def sense_agent(a, arena, srcs, plan, stage, out_m, out_a, out_err):
     thr1 = c[TOL_MORM] if flags[CULL] else -1.0
     thr2 = c[TOL_AMP] if flags[CULL] else -1.0
     n_dense, tot1, tot2, err1, err2 = gather_sources(a, ax, ay, thr1, thr2, srcs, c, plan.level_lcq, plan.level_e,
-                                                     stage)
+                                                     stage, flags[ERROR_BOUND])
     tot1 += srcs.bound_m  # plus the shared sources' bounds and errors
     tot2 += srcs.bound_a
     err1 += srcs.error_m
@@ -249,8 +250,9 @@ def sense_agent(a, arena, srcs, plan, stage, out_m, out_a, out_err):
     walls = flags[DO_WALLDIST] and arena.emitting[a] and arena.img.shape[0] > 1 and c[G_SELF] != 0
     do_m = flags[DO_MORM] and (walls or not flags[CULL] or tot1 > c[ZERO_MORM])
     do_a = flags[DO_AMP] and (not flags[CULL] or tot2 > c[ZERO_AMP])
-    out_err[0] = (err1 if do_m else tot1) if flags[DO_MORM] else 0.0
-    out_err[1] = (err2 if do_a else tot2) if flags[DO_AMP] else 0.0
+    if flags[ERROR_BOUND]:
+        out_err[0] = (err1 if do_m else tot1) if flags[DO_MORM] else 0.0
+        out_err[1] = (err2 if do_a else tot2) if flags[DO_AMP] else 0.0
     sx, sy, nx, ny = sens[0], sens[1], sens[2], sens[3]
     if do_m:
         place_sensors(ax, ay, heading, trig[0, :sm], trig[1, :sm], c[R_SENS], sx[:sm], sy[:sm], nx[:sm], ny[:sm])
@@ -410,7 +412,7 @@ def sense_arenas(batch, plan, ws, out):
         srcs = SourceList(lst, own, owner, nb * img.shape[0], 0, False, 0.0, 0.0, 0.0, 0.0)  # all sources, per agent
         if share and sense:  # or only those that are not shared
             image_rows(img, body[B_T1X, :nb], body[B_T1Y, :nb], lst[L_T1X], lst[L_T1Y], lst[L_A1])
-            srcs = share_far_sources(srcs.n, axy, s_max, c, level_lcq, level_e, lists, stage)
+            srcs = share_far_sources(srcs.n, axy, s_max, c, level_lcq, level_e, lists, stage, flags[ERROR_BOUND])
         weighs, srcs_lst, srcs_owner = flags[DO_MORM] and induction, srcs.lst, srcs.owner
         m1x, m1y = body[B_M1X, :nb], body[B_M1Y, :nb]
         for a in range(n if sense else 0):

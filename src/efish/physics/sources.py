@@ -261,7 +261,7 @@ def copy_columns(src, rows, index, count, dst, first):
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def share_far_sources(n, axy, s_max, c, level_lcq, level_e, lists, stage):
+def share_far_sources(n, axy, s_max, c, level_lcq, level_e, lists, stage, want_error):
     """Split the first ``n`` sources of ``lists.lst`` into those every agent serves by the first far level and the rest.
 
     ``axy``: DT[N, 2], the arena's agents; ``level_lcq``, ``level_e``: float64[L]
@@ -273,7 +273,8 @@ def share_far_sources(n, axy, s_max, c, level_lcq, level_e, lists, stage):
     sources go to ``lists.shared`` (rows ``S_*``), the rest to ``lists.rest`` (rows
     ``L_*``, with ``lists.rest_own`` and ``lists.rest_owner``). Returns the rest as
     the :class:`~efish.physics.kernel_inputs.SourceList` each agent stages, with the
-    bound sums of the shared sources in both columns (for each agent's exact-zero test).
+    bound sums of the shared sources in both columns (for each agent's exact-zero test) and, when
+    ``want_error``, their interpolation error bounds (else 0).
     """
     lst, geo, flag, order = lists.lst, stage.geo, stage.in_dense, stage.order
     own, owner = lists.own[:n], lists.owner[:n]
@@ -296,9 +297,10 @@ def share_far_sources(n, axy, s_max, c, level_lcq, level_e, lists, stage):
     for k in range(n):
         rest_index[n_rest] = k
         n_rest += (flag[k] == 0) | (owner[k] != NOBODY)
-    # their interpolation error at the nearest agent bounds it at every agent (farther, weight <= s_max)
-    err1, err2 = level_error(flag[:n] & (owner == NOBODY), d2, unit, a1, a2, a1, a2, 2.0 ** level_lcq[0],
-                             int(level_e[0]), c[R_SENS])
+    err1 = err2 = 0.0
+    if want_error:  # their interpolation error at the nearest agent bounds it at every agent (farther, weight <= s_max)
+        err1, err2 = level_error(flag[:n] & (owner == NOBODY), d2, unit, a1, a2, a1, a2, 2.0 ** level_lcq[0],
+                                 int(level_e[0]), c[R_SENS])
     copy_columns(lst, (L_X, L_Y, L_T1X, L_T1Y, L_M2X, L_M2Y), order, n_shared, lists.shared, 0)
     copy_columns(lst, (L_X, L_Y, L_T1X, L_T1Y, L_M2X, L_M2Y, L_A1, L_A2), rest_index, n_rest, lists.rest, 0)
     rest_own, rest_owner = lists.rest_own, lists.rest_owner
@@ -383,7 +385,7 @@ def staged_error(n, geo, a2, in_dense, bucket, level_lcq, level_e, r):
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def gather_sources(a, ax, ay, thr1, thr2, srcs, c, level_lcq, level_e, stage):
+def gather_sources(a, ax, ay, thr1, thr2, srcs, c, level_lcq, level_e, stage, want_error):
     """Stage the listed sources of ``srcs`` whose bound at agent ``a`` (at (ax, ay)) reaches a threshold, by level.
 
     ``stage.geo`` rows G_P1X, G_P1Y, G_A1 hold the agent's Mormyromast moments
@@ -441,5 +443,7 @@ def gather_sources(a, ax, ay, thr1, thr2, srcs, c, level_lcq, level_e, stage):
         if offsets[lv + 1] > offsets[lv]:
             end = fill_bucket(bucket, lv, x, y, geo, ax, ay, members, far, offsets[lv])
             pad_bucket(far, end, offsets[lv + 1], 0.0)
+    if not want_error:  # the bound costs a pass over every staged source: only when asked
+        return n_dense, total1, total2, 0.0, 0.0
     err1, err2 = staged_error(n, geo, lst[L_A2, :n], in_dense, bucket, level_lcq, level_e, c[R_SENS])
     return n_dense, total1, total2, skipped1 + err1, skipped2 + err2
