@@ -30,11 +30,14 @@ class ActionDistribution:
         return ActionDistribution(self.mean.to(dtype), self.log_std.to(dtype), self.logits.to(dtype))
 
     def sample(self, generator: torch.Generator | None = None) -> torch.Tensor:
-        """Stochastic actions (training)."""
-        noise = torch.randn(self.mean.shape, generator=generator, dtype=self.mean.dtype, device=self.mean.device)
-        gauss = self.mean + self.log_std.exp() * noise
+        """Stochastic actions (training). Noise is drawn on the generator's device (the CPU in training, whatever
+        device the networks use) and moved to the parameters', so a run's random stream does not depend on it."""
+        where = generator.device if generator is not None else self.mean.device
+        noise = torch.randn(self.mean.shape, generator=generator, dtype=self.mean.dtype, device=where)
+        gauss = self.mean + self.log_std.exp() * noise.to(self.mean.device)
         probs = torch.sigmoid(self.logits)
-        bern = (torch.rand(probs.shape, generator=generator, dtype=probs.dtype, device=probs.device) < probs)
+        uniform = torch.rand(probs.shape, generator=generator, dtype=probs.dtype, device=where)
+        bern = uniform.to(probs.device) < probs
         return torch.cat([gauss, bern.to(gauss.dtype)], dim=-1)
 
     def mode(self) -> torch.Tensor:

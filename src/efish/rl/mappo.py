@@ -8,6 +8,7 @@ import torch
 import torch.nn.functional as F
 
 from ..config.schema import TrainConfig
+from .compute import CPU_FP32, Compute
 from .networks import Actor, Critic
 from .value_norm import ValueNormalizer
 
@@ -34,11 +35,6 @@ class Rollout:
     h_critic: torch.Tensor
 
 
-def autocast(cfg: TrainConfig):
-    """bf16 autocast of forward passes when ``train.bf16`` is on (a no-op context otherwise)."""
-    return torch.autocast(device_type="cpu", dtype=torch.bfloat16, enabled=cfg.bf16)
-
-
 def chunked(x: torch.Tensor, chunk: int) -> torch.Tensor:
     """[T, S, ...] -> [L, (T/L) * S, ...]: every chunk becomes its own sequence."""
     t, s = x.shape[:2]
@@ -46,10 +42,10 @@ def chunked(x: torch.Tensor, chunk: int) -> torch.Tensor:
 
 
 def micro_losses(cfg: TrainConfig, actor: Actor, critic: Critic, data: dict, h_a: torch.Tensor, h_c: torch.Tensor,
-                 idx: torch.Tensor, share: float) -> dict[str, float]:
+                 idx: torch.Tensor, share: float, compute: Compute) -> dict[str, float]:
     """Losses of the sequences ``idx``; backpropagates ``share`` x (actor loss) and ``share`` x (critic loss)
-    into the gradients, and returns the unweighted statistics."""
-    with autocast(cfg):
+    into the gradients, and returns the unweighted statistics. Forward passes run in ``compute``'s precision."""
+    with compute.autocast():
         dist, _, _ = actor(data["obs"][:, idx], h_a[idx], data["starts"][:, idx])
     dist = dist.to(torch.float32)
     logp = dist.log_prob(data["actions"][:, idx])
@@ -59,7 +55,7 @@ def micro_losses(cfg: TrainConfig, actor: Actor, critic: Critic, data: dict, h_a
     entropy = dist.entropy().mean()
     (share * (policy_loss - cfg.entropy_coef * entropy)).backward()
 
-    with autocast(cfg):
+    with compute.autocast():
         values, _ = critic(data["state"][:, idx], h_c[idx], data["starts"][:, idx])
     values = values.float()
     old, tgt = data["values"][:, idx], data["targets"][:, idx]
@@ -77,8 +73,10 @@ def micro_losses(cfg: TrainConfig, actor: Actor, critic: Critic, data: dict, h_a
 
 def ppo_update(cfg: TrainConfig, actor: Actor, critic: Critic, actor_opt: torch.optim.Optimizer,
                critic_opt: torch.optim.Optimizer, value_norm: ValueNormalizer, ro: Rollout,
-               generator: torch.Generator) -> dict[str, float]:
-    """Epochs of clipped-surrogate and clipped-Huber-value updates; returns mean statistics."""
+               generator: torch.Generator, compute: Compute = CPU_FP32) -> dict[str, float]:
+    """Epochs of clipped-surrogate and clipped-Huber-value updates; returns mean statistics.
+
+    The rollout lives on ``compute.device``; ``generator`` (the minibatch order) stays on the CPU."""
     value_norm.update(ro.returns)
     targets = value_norm.normalize(ro.returns)
     adv = (ro.advantages - ro.advantages.mean()) / (ro.advantages.std() + 1e-8)
@@ -97,9 +95,9 @@ def ppo_update(cfg: TrainConfig, actor: Actor, critic: Critic, actor_opt: torch.
             actor_opt.zero_grad()
             critic_opt.zero_grad()
             sums = dict.fromkeys(stats, 0.0)
-            for micro in idx.split(cfg.micro_sequences):
+            for micro in idx.to(compute.device).split(cfg.micro_sequences):
                 share = len(micro) / len(idx)
-                for k, v in micro_losses(cfg, actor, critic, data, h_a, h_c, micro, share).items():
+                for k, v in micro_losses(cfg, actor, critic, data, h_a, h_c, micro, share, compute).items():
                     sums[k] += share * v
             torch.nn.utils.clip_grad_norm_(actor.parameters(), cfg.max_grad_norm)
             actor_opt.step()

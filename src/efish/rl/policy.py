@@ -50,7 +50,7 @@ def load_policy(path: str | Path) -> Policy:
     if path.is_dir():
         path = path / FINAL if (path / FINAL).exists() else path / CHECKPOINT
     try:
-        state = torch.load(path, weights_only=False)
+        state = torch.load(path, weights_only=False, map_location="cpu")  # a policy trained on a GPU acts on CPUs
         arch = state["architecture"]
         actor = Actor(arch["obs_dim"], arch["hidden"])
         actor.load_state_dict(state["actor"])

@@ -2,9 +2,10 @@
 
 Readable top to bottom: collect a rollout with the current policy, compute
 advantages, run the PPO epochs, log one metrics row, checkpoint. A checkpoint
-holds the networks, optimisers, value normaliser, every RNG state and the
-environment state, so a resumed run ends with the same weights as an
-uninterrupted one.
+holds the networks, optimisers, value normaliser, every RNG state, the
+environment state and the precision the run computes in, so a resumed run ends
+with the same weights as an uninterrupted one. The networks and the update run
+on ``train.device``; the environment and every random draw stay on the CPU.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ from ..env.vec_env import VecEnv
 from ..io import atomic_path, remove_partial_writes
 from ..physics.geometry import conspecific_slots
 from .advantages import gae
+from .compute import Compute, resolve_compute, resolve_device
 from .mappo import Rollout, ppo_update
 from .networks import Actor, Critic
 from .value_norm import ValueNormalizer
@@ -31,6 +33,7 @@ CHECKPOINT = "checkpoint.pt"
 LOG = logging.getLogger(__name__)
 FINAL = "final.pt"  # the finished run: what the pipeline declares as the training output
 METRICS = "metrics.parquet"
+CPU = torch.device("cpu")
 
 
 def agent_centric_state(obs: np.ndarray) -> np.ndarray:
@@ -43,31 +46,44 @@ def agent_centric_state(obs: np.ndarray) -> np.ndarray:
 class Learner:
     """Networks, optimisers and value normaliser of one seed."""
 
-    def __init__(self, cfg: EfishConfig, obs_dim: int, n_agents: int):
+    def __init__(self, cfg: EfishConfig, obs_dim: int, n_agents: int, device: torch.device = CPU):
         t = cfg.train
         torch.manual_seed(t.seed)
-        self.actor = Actor(obs_dim, t.hidden, t.head_gain)
-        self.critic = Critic(obs_dim * n_agents, t.hidden, t.head_gain)
-        self.value_norm = ValueNormalizer()
+        self.device = device
+        # initialised on the CPU and then moved, so every device starts from the same weights
+        self.actor = Actor(obs_dim, t.hidden, t.head_gain).to(device)
+        self.critic = Critic(obs_dim * n_agents, t.hidden, t.head_gain).to(device)
+        self.value_norm = ValueNormalizer().to(device)
         self.actor_opt = torch.optim.Adam(self.actor.parameters(), lr=t.lr, eps=t.adam_eps, weight_decay=t.weight_decay)
         self.critic_opt = torch.optim.Adam(self.critic.parameters(), lr=t.lr, eps=t.adam_eps, weight_decay=t.weight_decay)
         self.architecture = {"obs_dim": obs_dim, "n_agents": n_agents, "hidden": t.hidden}
 
 
-def initial_carry(obs: np.ndarray, hidden: int) -> dict:
+def initial_carry(obs: np.ndarray, hidden: int, device: torch.device = CPU) -> dict:
     """What a rollout hands to the next: the last observation [B, N, D], both networks' hidden states [B*N, H],
-    episode starts and the running episode return [B*N] (all episodes start now)."""
+    episode starts and the running episode return [B*N] (all episodes start now). Tensors live on ``device``."""
     s = obs.shape[0] * obs.shape[1]
-    return {"obs": obs, "h_actor": torch.zeros(s, hidden), "h_critic": torch.zeros(s, hidden), "starts": torch.ones(s),
+    return {"obs": obs, "h_actor": torch.zeros(s, hidden, device=device),
+            "h_critic": torch.zeros(s, hidden, device=device), "starts": torch.ones(s, device=device),
             "episode_return": np.zeros(s)}
+
+
+def carry_to(carry: dict, device: torch.device) -> dict:
+    """The carry with its tensors on ``device`` (a checkpoint stores them on the CPU)."""
+    return {k: v.to(device) if isinstance(v, torch.Tensor) else v for k, v in carry.items()}
 
 
 def collect(cfg: EfishConfig, env: VecEnv, learner: Learner, carry: dict, generator: torch.Generator
             ) -> tuple[Rollout, dict]:
-    """Step the env ``rollout_steps`` times with the current policy; returns the rollout and episode stats."""
+    """Step the env ``rollout_steps`` times with the current policy; returns the rollout (on the learner's device)
+    and episode stats. ``generator`` is a CPU generator: actions are sampled with it whatever the device."""
     t_cfg = cfg.train
     T, L, B, N = t_cfg.rollout_steps, t_cfg.chunk, env.num_envs, env.n
     S = B * N
+    dev = learner.device
+
+    def tensor(a: np.ndarray, dtype: torch.dtype | None = None) -> torch.Tensor:
+        return torch.as_tensor(a, dtype=dtype).to(dev)
     obs_np, h_a, h_c, starts_now = carry["obs"], carry["h_actor"], carry["h_critic"], carry["starts"]
     buf = {k: [] for k in ("obs", "state", "actions", "logp", "values", "rewards", "terminated", "truncated",
                            "starts", "next_values")}
@@ -77,23 +93,23 @@ def collect(cfg: EfishConfig, env: VecEnv, learner: Learner, carry: dict, genera
             if t % L == 0:
                 h_actor_chunks.append(h_a.clone())
                 h_critic_chunks.append(h_c.clone())
-            obs = torch.as_tensor(obs_np.reshape(1, S, -1))
-            state = torch.as_tensor(agent_centric_state(obs_np).reshape(1, S, -1))
+            obs = tensor(obs_np.reshape(1, S, -1))
+            state = tensor(agent_centric_state(obs_np).reshape(1, S, -1))
             dist, h_a, _ = learner.actor(obs, h_a, starts_now[None])
             values, h_c = learner.critic(state, h_c, starts_now[None])
             actions = dist.sample(generator)
-            next_obs, reward, term, trunc, info = env.step(actions.reshape(B, N, 4).numpy())
+            next_obs, reward, term, trunc, info = env.step(actions.reshape(B, N, 4).cpu().numpy())
             done = np.repeat(term | trunc, N)
-            next_values = torch.zeros(S)
+            next_values = torch.zeros(S, device=dev)
             if trunc.any():  # bootstrap truncated episodes from their final observation
                 final = info["final_obs"]
-                fs = torch.as_tensor(agent_centric_state(final).reshape(1, S, -1))
-                nv, _ = learner.critic(fs, h_c, torch.zeros(1, S))
+                fs = tensor(agent_centric_state(final).reshape(1, S, -1))
+                nv, _ = learner.critic(fs, h_c, torch.zeros(1, S, device=dev))
                 next_values = learner.value_norm.denormalize(nv[0])
             for k, v in (("obs", obs[0]), ("state", state[0]), ("actions", actions[0]), ("logp", dist.log_prob(actions)[0]),
-                         ("values", values[0]), ("rewards", torch.as_tensor(reward.reshape(S), dtype=torch.float32)),
-                         ("terminated", torch.as_tensor(np.repeat(term, N))),
-                         ("truncated", torch.as_tensor(np.repeat(trunc, N))), ("starts", starts_now),
+                         ("values", values[0]), ("rewards", tensor(reward.reshape(S), torch.float32)),
+                         ("terminated", tensor(np.repeat(term, N))),
+                         ("truncated", tensor(np.repeat(trunc, N))), ("starts", starts_now),
                          ("next_values", next_values)):
                 buf[k].append(v)
             for name, v in info["reward_parts"].items():
@@ -102,10 +118,10 @@ def collect(cfg: EfishConfig, env: VecEnv, learner: Learner, carry: dict, genera
             if done.any():
                 returns_done += carry["episode_return"][done].tolist()
                 carry["episode_return"][done] = 0.0
-            starts_now = torch.as_tensor(done, dtype=torch.float32)
+            starts_now = tensor(done, torch.float32)
             obs_np = next_obs
         # V(s_{t+1}) within the episode: the next step's value, or the bootstrap at truncation
-        last_state = torch.as_tensor(agent_centric_state(obs_np).reshape(1, S, -1))
+        last_state = tensor(agent_centric_state(obs_np).reshape(1, S, -1))
         last_value, _ = learner.critic(last_state, h_c, starts_now[None])
     data = {k: torch.stack(v) for k, v in buf.items()}
     values_dn = learner.value_norm.denormalize(data["values"])
@@ -127,29 +143,38 @@ def train(cfg: EfishConfig, out_dir: str | Path, progress=None, restart: bool = 
     """Train one seed into ``out_dir`` (checkpoint.pt, metrics.parquet, and final.pt at the end).
 
     Resumes from a checkpoint there only when it was written under the same
-    config (apart from the schema's result-neutral keys: threads, checkpoint
-    interval, a longer ``total_steps``); any other difference is one clear
-    error. ``restart`` discards the folder's checkpoint and starts afresh. A
-    finished run is written out again (final.pt, metrics.parquet) without
-    further updates.
+    config (apart from the schema's result-neutral keys: threads, device,
+    checkpoint interval, a longer ``total_steps``) and computes in the same
+    precision (``precision=auto`` takes the checkpoint's); any other difference
+    is one clear error. ``restart`` discards the folder's checkpoint and starts
+    afresh. A finished run is written out again (final.pt, metrics.parquet)
+    without further updates. The returned metrics carry the resolved device
+    and precision, with the GEMM rates auto measured, in
+    ``.attrs["compute"]`` (for provenance.json).
     """
     out = Path(out_dir)
     t_cfg = cfg.train
     torch.set_num_threads(t_cfg.threads)
+    resolve_device(t_cfg.device)  # a device this machine lacks fails here, before anything is touched
     env = VecEnv(cfg, num_envs=t_cfg.num_envs, seed=t_cfg.seed)
     obs = env.reset()  # bad env settings fail here, before anything is written
-    learner = Learner(cfg, obs.shape[-1], env.n)
-    carry = initial_carry(obs, t_cfg.hidden)
-    generator = torch.Generator().manual_seed(t_cfg.seed)
-    steps_per_update = t_cfg.rollout_steps * t_cfg.num_envs
-    total_updates = max(1, t_cfg.total_steps // steps_per_update)
-    rows, update = [], 0
     remove_partial_writes(out)  # temporaries of a killed run
     if restart:
         for name in (CHECKPOINT, FINAL, METRICS):
             (out / name).unlink(missing_ok=True)
-    if (out / CHECKPOINT).exists():
-        update, rows = load_checkpoint(out / CHECKPOINT, cfg, learner, env, carry, generator, total_updates)
+    state = read_checkpoint(out / CHECKPOINT) if (out / CHECKPOINT).exists() else None
+    compute = resolve_compute(cfg, recorded_precision(state) if state else None)
+    LOG.info("networks on %s, precision %s (%s%s)", compute.device, compute.precision, compute.chosen_by,
+             "".join(f", {k} GEMM {v / 1e9:.1f} GFLOP/s" for k, v in compute.gemm_flops.items()))
+    learner = Learner(cfg, obs.shape[-1], env.n, compute.device)
+    carry = initial_carry(obs, t_cfg.hidden, compute.device)
+    generator = torch.Generator().manual_seed(t_cfg.seed)
+    steps_per_update = t_cfg.rollout_steps * t_cfg.num_envs
+    total_updates = max(1, t_cfg.total_steps // steps_per_update)
+    rows, update = [], 0
+    if state is not None:
+        update, rows = restore_checkpoint(state, out / CHECKPOINT, cfg, compute, learner, env, carry, generator,
+                                          total_updates)
         LOG.info("resumed from %s at update %d (%d env steps)", out / CHECKPOINT, update, update * steps_per_update)
     out.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
@@ -157,7 +182,7 @@ def train(cfg: EfishConfig, out_dir: str | Path, progress=None, restart: bool = 
         t0 = time.perf_counter()
         ro, episode = collect(cfg, env, learner, carry, generator)
         losses = ppo_update(t_cfg, learner.actor, learner.critic, learner.actor_opt, learner.critic_opt,
-                            learner.value_norm, ro, generator)
+                            learner.value_norm, ro, generator, compute)
         update += 1
         seconds = time.perf_counter() - t0
         rows.append({"update": update, "env_steps": update * steps_per_update, "wall_s": time.perf_counter() - start,
@@ -165,14 +190,16 @@ def train(cfg: EfishConfig, out_dir: str | Path, progress=None, restart: bool = 
         if progress:
             progress(rows[-1], total_updates)
         if update % t_cfg.checkpoint_every == 0 or update == total_updates:
-            save_checkpoint(out / CHECKPOINT, cfg, learner, env, carry, generator, update, rows)
+            save_checkpoint(out / CHECKPOINT, cfg, compute, learner, env, carry, generator, update, rows)
             write_metrics(out / METRICS, rows)
     # Written at the end, atomically: a killed job never leaves a final.pt, so the workflow reruns it and the
     # rerun resumes from checkpoint.pt; a finished run rerun with its config writes both outputs again.
     write_metrics(out / METRICS, rows)
     with atomic_path(out / FINAL) as tmp:
         shutil.copyfile(out / CHECKPOINT, tmp)
-    return pd.DataFrame(rows)
+    df = pd.DataFrame(rows)
+    df.attrs["compute"] = compute.record()
+    return df
 
 
 def write_metrics(path: Path, rows: list[dict]) -> None:
@@ -181,11 +208,13 @@ def write_metrics(path: Path, rows: list[dict]) -> None:
         pd.DataFrame(rows).to_parquet(tmp, index=False)
 
 
-def save_checkpoint(path: Path, cfg: EfishConfig, learner: Learner, env: VecEnv, carry: dict,
+def save_checkpoint(path: Path, cfg: EfishConfig, compute: Compute, learner: Learner, env: VecEnv, carry: dict,
                     generator: torch.Generator, update: int, rows: list[dict]) -> None:
-    """Everything a resumed run needs to continue bit for bit, and the config it ran under, written atomically."""
+    """Everything a resumed run needs to continue bit for bit, the config it ran under and the precision it
+    computed in, written atomically (tensors on the CPU, so any device can resume it)."""
     state = {
-        "architecture": learner.architecture, "config": training_config(cfg), "update": update, "metrics": rows,
+        "architecture": learner.architecture, "config": training_config(cfg), "precision": compute.precision,
+        "update": update, "metrics": rows,
         "actor": learner.actor.state_dict(), "critic": learner.critic.state_dict(),
         "value_norm": learner.value_norm.state_dict(),
         "actor_opt": learner.actor_opt.state_dict(), "critic_opt": learner.critic_opt.state_dict(),
@@ -193,19 +222,48 @@ def save_checkpoint(path: Path, cfg: EfishConfig, learner: Learner, env: VecEnv,
         "env": env.state_dict(), "carry": carry,
     }
     with atomic_path(path) as tmp:
-        torch.save(state, tmp)
+        torch.save(_to_cpu(state), tmp)
 
 
-def load_checkpoint(path: Path, cfg: EfishConfig, learner: Learner, env: VecEnv, carry: dict,
-                    generator: torch.Generator, total_updates: int) -> tuple[int, list[dict]]:
-    """Restore a checkpoint into live objects; one clear error if it does not fit this config."""
+def _to_cpu(obj):
+    """A nested structure of dicts and lists with every tensor moved to the CPU."""
+    if isinstance(obj, torch.Tensor):
+        return obj.cpu()
+    if isinstance(obj, dict):
+        return {k: _to_cpu(v) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [_to_cpu(v) for v in obj]
+    return obj
+
+
+def read_checkpoint(path: Path) -> dict:
+    """A checkpoint's contents (on the CPU); one clear error if it cannot be read."""
     try:
-        state = torch.load(path, weights_only=False)
-        recorded = state["config"]
+        state = torch.load(path, weights_only=False, map_location="cpu")
+        state["config"]
     except Exception as exc:  # truncated, foreign, or from before configs were recorded
         raise ValueError(f"cannot read checkpoint {path} ({type(exc).__name__}): delete it, or run again with "
                          "--restart to start afresh") from None
-    differ = config_differences(recorded, training_config(cfg), result_neutral_keys())
+    return state
+
+
+def recorded_precision(state: dict) -> str:
+    """The precision a checkpoint's run computed in (checkpoints from before train.precision: its bf16 flag)."""
+    return state.get("precision") or ("bf16" if state["config"]["train"].get("bf16") else "fp32")
+
+
+def _with_precision(config: dict, precision: str) -> dict:
+    """A recorded training config with train.precision replaced by the precision actually used: what a resume
+    must match (auto and an explicit value agree when auto chose that value)."""
+    return {**config, "train": {**config["train"], "precision": precision}}
+
+
+def restore_checkpoint(state: dict, path: Path, cfg: EfishConfig, compute: Compute, learner: Learner, env: VecEnv,
+                       carry: dict, generator: torch.Generator, total_updates: int) -> tuple[int, list[dict]]:
+    """Restore a read checkpoint into live objects; one clear error if it does not fit this config."""
+    recorded = _with_precision(state["config"], recorded_precision(state))
+    differ = config_differences(recorded, _with_precision(training_config(cfg), compute.precision),
+                                result_neutral_keys())
     if differ:
         raise ValueError(f"checkpoint {path} was written under another config ({', '.join(differ)} differ): run "
                          "again with --restart to start afresh, or use another --out")
@@ -218,10 +276,10 @@ def load_checkpoint(path: Path, cfg: EfishConfig, learner: Learner, env: VecEnv,
     learner.actor.load_state_dict(state["actor"])
     learner.critic.load_state_dict(state["critic"])
     learner.value_norm.load_state_dict(state["value_norm"])
-    learner.actor_opt.load_state_dict(state["actor_opt"])
+    learner.actor_opt.load_state_dict(state["actor_opt"])  # moves the moments to the parameters' device
     learner.critic_opt.load_state_dict(state["critic_opt"])
     torch.set_rng_state(state["torch_rng"])
     generator.set_state(state["generator"])
     env.load_state_dict(state["env"])
-    carry.update(state["carry"])
+    carry.update(carry_to(state["carry"], learner.device))
     return state["update"], list(state["metrics"])

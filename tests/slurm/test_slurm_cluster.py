@@ -1,0 +1,197 @@
+"""The slurm profile on a real scheduler: a one-node SLURM (workflow/slurm/local-cluster.sh) runs the smoke DAG.
+
+The SLURM run goes through ``workflow/profiles/slurm-local``, which is the slurm
+profile with each request cut to what one node has. Every job must run as a
+SLURM job (its sbatch id, and sacct's COMPLETED), its tables must equal a
+local run's (a hash per Parquet table, timing columns left out), and a
+training job cancelled with scancel mid-run must resume from its checkpoint
+when the workflow runs again. Skipped, with the reason, where the daemons,
+the executor plugin or root are missing.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import os
+import re
+import shutil
+import subprocess
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from ..workflow.test_pipeline import smoke_env
+
+REPO = Path(__file__).resolve().parents[2]
+SCRIPT = REPO / "workflow/slurm/local-cluster.sh"
+NEEDED = ("slurmctld", "slurmd", "slurmdbd", "munged", "mariadbd", "sbatch", "squeue", "sacct", "scancel")
+# Columns that measure the machine, not the result: they differ between any two runs.
+TIMING_COLUMNS = frozenset({"wall_s", "env_steps_per_s", "us_per_agent_step", "agent_steps_per_s"})
+SUBMITTED = re.compile(r"Job \d+ has been submitted with SLURM jobid (\d+)")
+
+
+def why_not() -> str | None:
+    """Why this machine cannot run the one-node cluster (one line), or None."""
+    missing = [c for c in NEEDED if shutil.which(c) is None]
+    if missing:
+        return (f"SLURM is not installed ({', '.join(missing)} missing): apt-get install slurm-wlm munge slurmdbd "
+                "mariadb-server")
+    if importlib.util.find_spec("snakemake_executor_plugin_slurm") is None:
+        return "snakemake-executor-plugin-slurm is not installed: pip install -e '.[slurm]'"
+    if os.geteuid() != 0:
+        return "the one-node cluster needs root (its daemons run as root)"
+    return None
+
+
+needs_cluster = pytest.mark.skipif(why_not() is not None, reason=why_not() or "")
+
+
+def test_the_cluster_script_says_how_to_install_what_is_missing():
+    result = subprocess.run(["/bin/bash", str(SCRIPT), "up"], capture_output=True, text=True, timeout=60,
+                            env={"PATH": "/nonexistent"})
+    assert result.returncode != 0
+    assert result.stderr.strip().splitlines() == [result.stderr.strip()]  # one line
+    assert re.search(r"missing .*slurmctld.*slurmd.*: install them with apt-get install slurm-wlm munge",
+                     result.stderr), result.stderr
+
+
+def scratch_workflow(folder: Path) -> Path:
+    """A copy of the workflow files (Snakefile, workflow/, config/) to run in."""
+    folder.mkdir(parents=True)
+    for name in ("Snakefile", "workflow", "config"):
+        src = REPO / name
+        (shutil.copytree if src.is_dir() else shutil.copy)(src, folder / name)
+    return folder
+
+
+def snakemake(work: Path, profile: str, *args: str) -> list[str]:
+    """The command running the workflow copy in ``work`` (run from there: profiles read paths relative to it)."""
+    return ["snakemake", "--profile", f"workflow/profiles/{profile}", "--directory", str(work),
+            "--snakefile", str(work / "Snakefile"), *args]
+
+
+def table_hashes(results: Path) -> dict[str, str]:
+    """Relative path -> sha256 of every Parquet table's rows (columns sorted, timing columns dropped)."""
+    hashes = {}
+    for path in sorted(results.glob("**/*.parquet")):
+        df = pd.read_parquet(path)
+        df = df[sorted(set(df.columns) - TIMING_COLUMNS)]
+        digest = hashlib.sha256(",".join(df.columns).encode())
+        digest.update(pd.util.hash_pandas_object(df, index=False).values.tobytes())
+        hashes[str(path.relative_to(results))] = digest.hexdigest()
+    return hashes
+
+
+def sacct_states(job_ids: list[str]) -> dict[str, tuple[str, str]]:
+    """SLURM job id -> (state, comment) from the accounting database."""
+    out = subprocess.run(["sacct", "-X", "-n", "-P", "-j", ",".join(job_ids), "--format=JobID,State,Comment"],
+                         capture_output=True, text=True, timeout=60, check=True).stdout
+    return {i: (s, c) for i, s, c in (line.split("|", 2) for line in out.splitlines() if line.strip())}
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    """The one-node cluster: brought up (and down afterwards) unless it already runs."""
+    if why_not() is not None:
+        pytest.skip(why_not())
+    running = subprocess.run([str(SCRIPT), "status"], capture_output=True, timeout=60).returncode == 0
+    if not running:
+        up = subprocess.run([str(SCRIPT), "up"], capture_output=True, text=True, timeout=300)
+        assert up.returncode == 0, up.stdout + up.stderr
+    yield
+    if not running:
+        down = subprocess.run([str(SCRIPT), "down"], capture_output=True, text=True, timeout=300)
+        assert down.returncode == 0, down.stdout + down.stderr
+
+
+@pytest.fixture(scope="module")
+def smoke_runs(cluster, tmp_path_factory) -> dict:
+    """The smoke DAG run locally and through SLURM at the same time, each in its own copy of the workflow."""
+    root = tmp_path_factory.mktemp("slurm")
+    local, slurm = scratch_workflow(root / "local"), scratch_workflow(root / "slurm")
+    local_run = subprocess.Popen(snakemake(local, "default", "--config", "scale=smoke"), cwd=local,
+                                 stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=smoke_env(local))
+    try:
+        slurm_run = subprocess.run(snakemake(slurm, "slurm-local", "--config", "scale=smoke"), cwd=slurm,
+                                   capture_output=True, text=True, timeout=3600, env=smoke_env(slurm))
+        local_err = local_run.communicate(timeout=3600)[1]
+    finally:
+        local_run.kill()
+    assert local_run.returncode == 0, local_err[-3000:]
+    assert slurm_run.returncode == 0, slurm_run.stderr[-3000:]
+    return {"local": local, "slurm": slurm, "log": slurm_run.stderr}
+
+
+@needs_cluster
+@pytest.mark.slurm
+@pytest.mark.slow
+def test_every_job_of_the_smoke_dag_ran_as_a_slurm_job(smoke_runs):
+    log = smoke_runs["log"]
+    steps = re.findall(r"(\d+) of (\d+) steps \(100%\) done", log)
+    assert steps, log[-2000:]
+    total = int(steps[-1][1])
+    local = len(re.findall(r"^localrule \w+:", log, flags=re.M))  # rule all: collects outputs, runs nothing
+    submitted = SUBMITTED.findall(log)
+    assert len(submitted) == total - local >= 50, (total, local, len(submitted))
+    states = sacct_states(submitted)
+    assert set(states) == set(submitted)
+    assert {state for state, _ in states.values()} == {"COMPLETED"}
+    rules = {comment.split("_wildcards_")[0] for _, comment in states.values()}
+    assert {"rule_train", "rule_train_policy", "rule_assay", "rule_select_seed"} <= rules, rules
+    assert not list((smoke_runs["slurm"] / "results").glob("**/*.tmp*"))
+
+
+@needs_cluster
+@pytest.mark.slurm
+@pytest.mark.slow
+def test_slurm_and_local_runs_write_the_same_tables(smoke_runs):
+    local = table_hashes(smoke_runs["local"] / "results/smoke")
+    slurm = table_hashes(smoke_runs["slurm"] / "results/smoke")
+    assert len(local) >= 50 and sorted(slurm) == sorted(local)
+    differ = sorted(k for k in local if local[k] != slurm[k])
+    assert not differ, differ
+
+
+@needs_cluster
+@pytest.mark.slurm
+@pytest.mark.slow
+def test_a_training_job_cancelled_by_scancel_resumes_from_its_checkpoint(cluster, tmp_path):
+    work = scratch_workflow(tmp_path / "kill")
+    seed_dir = work / "results/kill/train/seed_1"
+    command = snakemake(work, "slurm-local", "results/kill/train/seed_1/final.pt", "--config", "scale=smoke",
+                        "overrides=scale.train_steps=12000 train.checkpoint_every=1", "run=kill")
+    first = subprocess.Popen(command, cwd=work, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                             env=smoke_env(work), start_new_session=True)
+    try:
+        deadline = time.monotonic() + 600
+        while not (seed_dir / "checkpoint.pt").exists() and time.monotonic() < deadline and first.poll() is None:
+            time.sleep(0.5)
+        assert (seed_dir / "checkpoint.pt").exists(), "training never wrote a checkpoint"
+        queued = subprocess.run(["squeue", "-h", "-o", "%i|%k"], capture_output=True, text=True, timeout=60,
+                                check=True).stdout
+        job = [line.split("|")[0] for line in queued.splitlines() if "|rule_train_" in line]
+        assert len(job) == 1, queued
+        subprocess.run(["scancel", job[0]], check=True, timeout=60)
+        err = first.communicate(timeout=600)[1]
+    finally:
+        if first.poll() is None:
+            os.killpg(first.pid, 15)
+            first.wait(timeout=120)
+    assert first.returncode != 0, err[-2000:]  # Snakemake saw the job fail
+    assert (seed_dir / "checkpoint.pt").exists() and not (seed_dir / "final.pt").exists()
+    state, _ = sacct_states(job)[job[0]]
+    assert state.startswith("CANCELLED"), state
+
+    second = subprocess.run(command, cwd=work, capture_output=True, text=True, timeout=1800, env=smoke_env(work))
+    if second.returncode != 0:
+        subprocess.run([*command, "--unlock"], cwd=work, capture_output=True, timeout=300, env=smoke_env(work))
+    assert second.returncode == 0, second.stderr[-3000:]
+    assert SUBMITTED.search(second.stderr), "the rerun did not go through SLURM"
+    log = (work / "results/kill/logs/train/seed_1.log").read_text()
+    resumed = re.search(r"resumed from .* at update (\d+)", log)
+    assert resumed and int(resumed.group(1)) >= 1, log[-2000:]
+    metrics = pd.read_parquet(seed_dir / "metrics.parquet")
+    assert list(metrics["update"]) == list(range(1, 121))  # nothing lost, nothing repeated
