@@ -8,6 +8,7 @@ only holds fixtures. Configs are composed once per distinct override set
 from __future__ import annotations
 
 import functools
+from pathlib import Path
 
 import numpy as np
 
@@ -162,3 +163,24 @@ def _episodes_of(steps):
                 mean_nn_dist_cm=("dist_agent_cm", "mean"), **{"return": ("reward", "sum")}, steps=("t", "size"),
                 terminated=("terminated", "any"), success=("success", "any"))
     return out.reset_index()
+
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+def scratch_workflow(folder: Path) -> Path:
+    """A copy of the workflow files (Snakefile, workflow/, config/) in ``folder``, to run the pipeline in."""
+    import shutil
+
+    folder.mkdir(parents=True, exist_ok=True)
+    for name in ("Snakefile", "workflow", "config"):
+        src = REPO / name
+        (shutil.copytree if src.is_dir() else shutil.copy)(src, folder / name)
+    return folder
+
+
+def smoke_env(work: Path) -> dict:
+    """The environment of a pipeline run in the scratch copy ``work``: efish reads that copy's config."""
+    import os
+
+    return {**os.environ, "EFISH_CONFIG_DIR": str(work / "config")}

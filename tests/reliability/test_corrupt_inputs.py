@@ -72,10 +72,13 @@ def test_a_damaged_episodes_table_stops_selection_in_one_line(tmp_path, damage):
 
 
 def test_a_damaged_table_stops_a_panel_in_one_line(tmp_path):
+    from efish.figures.registry import PANELS
+
     results, out = tmp_path / "results", tmp_path / "figures"
-    table = results / "assays" / "patchy4" / "episodes.parquet"
-    table.parent.mkdir(parents=True)
-    table.write_bytes(b"PAR1 truncated")
+    for path in PANELS["fig3/M"].inputs.values():  # every input present, all damaged
+        table = results / path
+        table.parent.mkdir(parents=True, exist_ok=True)
+        table.write_bytes(b"PAR1 truncated")
     result = efish("figure", "fig3/M", "--results", str(results), "--out", str(out))
     assert_one_line_error(result, "cannot read")
     assert files(out) == []

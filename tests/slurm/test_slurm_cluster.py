@@ -23,7 +23,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from ..workflow.test_pipeline import smoke_env
+from ..helpers import scratch_workflow, smoke_env
 
 REPO = Path(__file__).resolve().parents[2]
 SCRIPT = REPO / "workflow/slurm/local-cluster.sh"
@@ -56,15 +56,6 @@ def test_the_cluster_script_says_how_to_install_what_is_missing():
     assert result.stderr.strip().splitlines() == [result.stderr.strip()]  # one line
     assert re.search(r"missing .*slurmctld.*slurmd.*: install them with apt-get install slurm-wlm munge",
                      result.stderr), result.stderr
-
-
-def scratch_workflow(folder: Path) -> Path:
-    """A copy of the workflow files (Snakefile, workflow/, config/) to run in."""
-    folder.mkdir(parents=True)
-    for name in ("Snakefile", "workflow", "config"):
-        src = REPO / name
-        (shutil.copytree if src.is_dir() else shutil.copy)(src, folder / name)
-    return folder
 
 
 def snakemake(work: Path, profile: str, *args: str) -> list[str]:
@@ -108,21 +99,13 @@ def cluster():
 
 
 @pytest.fixture(scope="module")
-def smoke_runs(cluster, tmp_path_factory) -> dict:
-    """The smoke DAG run locally and through SLURM at the same time, each in its own copy of the workflow."""
-    root = tmp_path_factory.mktemp("slurm")
-    local, slurm = scratch_workflow(root / "local"), scratch_workflow(root / "slurm")
-    local_run = subprocess.Popen(snakemake(local, "default", "--config", "scale=smoke"), cwd=local,
-                                 stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=smoke_env(local))
-    try:
-        slurm_run = subprocess.run(snakemake(slurm, "slurm-local", "--config", "scale=smoke"), cwd=slurm,
-                                   capture_output=True, text=True, timeout=3600, env=smoke_env(slurm))
-        local_err = local_run.communicate(timeout=3600)[1]
-    finally:
-        local_run.kill()
-    assert local_run.returncode == 0, local_err[-3000:]
+def smoke_runs(cluster, smoke_run, tmp_path_factory) -> dict:
+    """The smoke DAG through SLURM, in its own copy of the workflow, beside the session's local smoke run."""
+    slurm = scratch_workflow(tmp_path_factory.mktemp("slurm") / "slurm")
+    slurm_run = subprocess.run(snakemake(slurm, "slurm-local", "--config", "scale=smoke"), cwd=slurm,
+                               capture_output=True, text=True, timeout=3600, env=smoke_env(slurm))
     assert slurm_run.returncode == 0, slurm_run.stderr[-3000:]
-    return {"local": local, "slurm": slurm, "log": slurm_run.stderr}
+    return {"local": smoke_run, "slurm": slurm, "log": slurm_run.stderr}
 
 
 @needs_cluster

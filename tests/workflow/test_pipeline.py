@@ -19,22 +19,9 @@ from efish.bench.accuracy import COLUMNS
 from efish.config import run_name
 from efish.rollout.schema import SCHEMAS, check_file
 
+from ..helpers import smoke_env
+
 REPO = Path(__file__).resolve().parents[2]
-
-
-@pytest.fixture(scope="module")
-def smoke_run(tmp_path_factory) -> Path:
-    """Run the whole DAG at smoke scale in a scratch copy of the workflow files."""
-    work = tmp_path_factory.mktemp("pipeline")
-    for name in ("Snakefile", "workflow", "config"):
-        src = REPO / name
-        (shutil.copytree if src.is_dir() else shutil.copy)(src, work / name)
-    result = subprocess.run(
-        ["snakemake", "--cores", "2", "--config", "scale=smoke", "--directory", str(work),
-         "--snakefile", str(work / "Snakefile")],
-        capture_output=True, text=True, timeout=900, env=smoke_env(work))
-    assert result.returncode == 0, result.stderr[-3000:]
-    return work
 
 
 def declared_outputs(work: Path) -> list[str]:
@@ -138,10 +125,6 @@ def test_bad_input_fails_before_any_job(tmp_path, config, target, message):
 def dry_run(work: Path, *args: str) -> subprocess.CompletedProcess:
     return subprocess.run(["snakemake", "-n", "--cores", "1", "--snakefile", str(REPO / "Snakefile"),
                            "--directory", str(work), *args], capture_output=True, text=True, timeout=300)
-
-
-def smoke_env(work: Path) -> dict:
-    return {**os.environ, "EFISH_CONFIG_DIR": str(work / "config")}
 
 
 @pytest.mark.slow
