@@ -6,7 +6,7 @@
     efish assay [overrides] --policy P...     run an assay into steps/episodes/food(/hidden).parquet
     efish schema steps|episodes|food|hidden   the columns of a rollout table and what they mean
     efish select --episodes F... --out D      rank seeds, write the ranking and the chosen seed
-    efish stack-seeds TABLE... --ranking R --out F   the top seeds' tables as one, with seed and rank columns
+    efish stack-seeds --tables T... --ranking R --out F   the top seeds' tables as one, with seed and rank
     efish analyze NAME [overrides] --tables D --out D   one analysis of an assay's tables -> <table>.parquet
     efish figure FIG[/PANEL] [overrides]      draw a panel (or a figure's page) from the result tables
     efish render assay=NAME [overrides] [--condition C] [--episode K] [--out F.gif|F.mp4] [--field]
@@ -70,10 +70,10 @@ def _parser() -> argparse.ArgumentParser:
                      help="episodes.parquet files in folders named seed_<n>")
     sel.add_argument("--out", type=Path, required=True, help="folder for ranking.parquet and selected_seed.txt")
     st = sub.add_parser("stack-seeds", help="stack the top seeds' tables (each under seed_<n>/) into one table")
-    st.add_argument("tables", nargs="+", type=Path)
+    st.add_argument("overrides", nargs="*")
+    st.add_argument("--tables", nargs="+", type=Path, required=True, help="the seeds' tables, each under seed_<n>/")
     st.add_argument("--ranking", type=Path, required=True, help="the seed ranking (analysis/selection/ranking.parquet)")
     st.add_argument("--out", type=Path, required=True, help="the stacked table (.parquet)")
-    st.add_argument("overrides", nargs="*", default=[])
     an = sub.add_parser("analyze", help="run one analysis (efish.analysis.registry) on an assay's rollout tables")
     an.add_argument("name", help="an analysis of efish.analysis.registry, e.g. behaviour (a wrong name lists them)")
     an.add_argument("overrides", nargs="*", help="config overrides, e.g. assay=patchy4 analysis.rate_bins=10")

@@ -29,7 +29,9 @@ REPO = Path(__file__).resolve().parents[2]
 SCRIPT = REPO / "workflow/slurm/local-cluster.sh"
 NEEDED = ("slurmctld", "slurmd", "slurmdbd", "munged", "mariadbd", "sbatch", "squeue", "sacct", "scancel")
 # Columns that measure the machine, not the result: they differ between any two runs.
-TIMING_COLUMNS = frozenset({"wall_s", "env_steps_per_s", "us_per_agent_step", "agent_steps_per_s"})
+TIMING_COLUMNS = frozenset({"wall_s", "env_steps_per_s", "us_per_agent_step", "agent_steps_per_s",
+                            "fast_agent_steps_per_s", "exact_agent_steps_per_s", "fast_us_per_agent_step",
+                            "exact_us_per_agent_step", "speedup"})
 SUBMITTED = re.compile(r"Job \d+ has been submitted with SLURM jobid (\d+)")
 
 

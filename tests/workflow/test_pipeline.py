@@ -51,7 +51,9 @@ def test_every_table_matches_its_schema(smoke_run):
     tables = list((smoke_run / "results/smoke").glob("**/*.parquet"))
     checked = 0
     for path in tables:
-        if path.stem in SCHEMAS:
+        if path.parent.parent.name == "seeds":  # the top seeds stacked: the schema's columns, then seed and rank
+            assert list(pd.read_parquet(path).columns) == [*SCHEMAS[path.stem].names, "seed", "rank"], path
+        elif path.stem in SCHEMAS:
             check_file(path, path.stem)
             checked += 1
     assert checked >= 3 * (2 + 2)  # two assays and two seed evaluations, three tables each
@@ -64,10 +66,13 @@ def test_every_table_matches_its_schema(smoke_run):
 
 @pytest.mark.slow
 def test_every_output_folder_has_config_and_provenance(smoke_run):
-    folders = {p.parent for p in (smoke_run / "results/smoke").glob("**/*.parquet")}
-    for folder in folders:
+    tables = list((smoke_run / "results/smoke").glob("**/*.parquet"))
+    for folder in {p.parent for p in tables if p.parent.parent.name != "seeds"}:
         assert "name: smoke" in (folder / "config.yaml").read_text(), folder
-        check_provenance(folder / "provenance.json")
+    for table in tables:  # a folder of one command's tables has provenance.json, a folder of many (scenes) one each
+        own = table.with_name(f"{table.stem}.provenance.json")
+        if table.parent.parent.name != "seeds":
+            check_provenance(own if own.is_file() else table.parent / "provenance.json")
     # figures: every drawn PNG (panels, pages, the accuracy figure) has a PDF and its own provenance
     drawn = list((smoke_run / "figures/smoke").glob("**/*.png"))
     assert any(p.parent.name == "bench" for p in drawn) and any(p.parent.name == "smoke" for p in drawn)
@@ -197,7 +202,7 @@ def test_a_killed_training_job_resumes_from_its_checkpoint(tmp_path):
     seed_dir = tmp_path / "results/kill/train/seed_1"
     command = ["snakemake", "results/kill/train/seed_1/final.pt", "--cores", "1", "--rerun-incomplete",
                "--directory", str(tmp_path), "--snakefile", str(tmp_path / "Snakefile"), "--config", "scale=smoke",
-               "overrides=scale.train_steps=6000 train.checkpoint_every=1", "run=kill"]
+               "overrides=scale.train_steps=30000 train.checkpoint_every=1", "run=kill"]
     first = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True,
                              env=smoke_env(tmp_path))
     deadline = time.monotonic() + 240

@@ -71,5 +71,8 @@ rule top_seeds:
         "results/{run}/logs/seeds/{assay}.log",
     conda:
         "../envs/efish.yaml"
+    params:
+        overrides=ARGS,
     shell:
-        "efish stack-seeds {input.tables} --ranking {input.ranking} --out {output} > {log} 2>&1"
+        "efish stack-seeds {params.overrides} --tables {input.tables} --ranking {input.ranking} --out {output} "
+        "> {log} 2>&1"

@@ -8,6 +8,7 @@ import shlex
 import sys
 from pathlib import Path
 
+from efish.analysis.claims import claim_tables, produced_tables
 from efish.analysis.registry import ANALYSES, analyses_for, tables_written
 from efish._numba_cache import source_digest
 from efish.config import ConfigError, compose, config_dir, run_name
@@ -166,6 +167,27 @@ def panel_of(wildcards):
     if key not in PANELS:
         fail(f"unknown panel {key!r}: choose one of {', '.join(PANELS)}")
     return PANELS[key]
+
+
+# The assays whose clips the report shows (issue 15): homing, foraging in the patchy and the wide arena, the
+# resident and the intruder at one patch.
+CLIP_ASSAYS = [name for name in ("homing", "patchy4", "wide2", "onepatch") if name in ASSAYS]
+
+
+def clip_condition(wildcards):
+    """The clip's condition: the first of the assay's config (config/assay/<name>.yaml)."""
+    return next(iter(assay_config(wildcards.assay).assay.conditions))
+
+
+def render_targets():
+    """The clips and the contact sheet of this run (for rule all)."""
+    return [f"figures/{RUN}/clips/{name}.gif" for name in CLIP_ASSAYS] + [f"figures/{RUN}/contact_sheet.png"]
+
+
+def claims_inputs(wildcards):
+    """The claims' tables among those the assays of this scale write (rollout tables and their analyses)."""
+    produced = produced_tables({name: assay_config(name).assay for name in ASSAYS})
+    return [f"results/{wildcards.run}/{path}" for path in claim_tables() if path in produced]
 
 
 def all_targets():

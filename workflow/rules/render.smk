@@ -1,20 +1,6 @@
 # Episode clips and the contact sheet: one clip of the first episode of the first condition of each assay in
 # CLIP_ASSAYS that the scale runs (efish render), and one page of every panel's thumbnail (efish contact-sheet).
 
-# The assays whose clips the report shows (issue 15): homing, foraging in the patchy and the wide arena, the
-# resident and the intruder at one patch.
-CLIP_ASSAYS = [name for name in ("homing", "patchy4", "wide2", "onepatch") if name in ASSAYS]
-
-
-def clip_condition(wildcards):
-    """The clip's condition: the first of the assay's config (config/assay/<name>.yaml)."""
-    return next(iter(assay_config(wildcards.assay).assay.conditions))
-
-
-def render_targets():
-    """The clips and the contact sheet of this run (for rule all)."""
-    return [f"figures/{RUN}/clips/{name}.gif" for name in CLIP_ASSAYS] + [f"figures/{RUN}/contact_sheet.png"]
-
 
 rule render_clip:
     input:
