@@ -184,3 +184,21 @@ def smoke_env(work: Path) -> dict:
     import os
 
     return {**os.environ, "EFISH_CONFIG_DIR": str(work / "config")}
+
+
+def draw_panel_axes(key: str, tables: dict):
+    """Draw registered panel ``key`` from ``tables`` on a fresh axes; returns the axes (figure closed, still readable)."""
+    from efish.figures.registry import PANELS
+    from efish.figures.style import panel_style
+
+    with panel_style() as plt:
+        fig = plt.figure()
+        ax = fig.add_subplot()
+        PANELS[key].draw(tables, ax)
+        plt.close(fig)
+    return ax
+
+
+def panel_texts(ax) -> list[str]:
+    """Every text drawn on ``ax``."""
+    return [t.get_text() for t in ax.texts]

@@ -11,21 +11,10 @@ from efish.figures.registry import PANELS
 from efish.figures.render import load_tables, render_panel
 from efish.figures.style import box_strip, panel_style
 
+from ..helpers import draw_panel_axes as draw
+from ..helpers import panel_texts as texts
+
 FIG4 = [key for key in PANELS if key.startswith("fig4/")]
-
-
-def draw(key: str, tables: dict):
-    """Draw panel ``key`` from ``tables`` on a fresh axes; returns the axes (its figure closed, still readable)."""
-    with panel_style() as plt:
-        fig = plt.figure()
-        ax = fig.add_subplot()
-        PANELS[key].draw(tables, ax)
-        plt.close(fig)
-    return ax
-
-
-def texts(ax) -> list[str]:
-    return [t.get_text() for t in ax.texts]
 
 
 def points_at(ax, x: float) -> np.ndarray:

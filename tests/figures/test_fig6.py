@@ -9,25 +9,13 @@ import pytest
 from efish.figures import fig6
 from efish.figures.registry import PANELS
 from efish.figures.render import load_tables, render_panel
-from efish.figures.style import panel_style
+
+from ..helpers import draw_panel_axes as draw
+from ..helpers import panel_texts as texts
 
 FIG6 = [key for key in PANELS if key.startswith("fig6/")]
 #: Panels whose data no analysis table holds yet: they say so on themselves.
 NOT_ANALYSED = {"fig6/F"}
-
-
-def draw(key: str, tables: dict):
-    """Draw panel ``key`` from ``tables`` on a fresh axes; returns the axes (its figure closed, still readable)."""
-    with panel_style() as plt:
-        fig = plt.figure()
-        ax = fig.add_subplot()
-        PANELS[key].draw(tables, ax)
-        plt.close(fig)
-    return ax
-
-
-def texts(ax) -> list[str]:
-    return [t.get_text() for t in ax.texts]
 
 
 def test_every_letter_of_spec_13_is_registered():
