@@ -20,6 +20,7 @@
     efish bench scaling [overrides] --out D   cost per agent-step vs pellets and agents -> table + figure
     efish bench env [overrides] [--json]      env-only throughput, fast vs reference physics
     efish bench train [overrides] [--json]    rollout/update speed, model-FLOP utilisation
+    efish bench budget [overrides] --minutes M fixed training time: wider net, more steps or more seeds?
     efish bench pipeline [--results D]        time per rule family of a pipeline run (Snakemake benchmarks)
     efish plan-cluster [overrides]            every job of a scale (scale=paper) with runtime, memory, cores, vs the
                                               slurm profile (from the laptop run's benchmark files)
@@ -135,6 +136,13 @@ def _parser() -> argparse.ArgumentParser:
     bt.add_argument("overrides", nargs="*")
     bt.add_argument("--json", action="store_true", help="print JSON instead of a table")
     bt.add_argument("--hidden", type=int, nargs="+", default=[512, 64], help="widths to time (default 512 64)")
+    bb = bsub.add_parser("budget", help="at fixed training time: a wider network, more env steps or more seeds")
+    bb.add_argument("overrides", nargs="*")
+    bb.add_argument("--minutes", type=float, default=10.0, help="wall time of each run (default 10)")
+    bb.add_argument("--hidden", type=int, nargs="+", default=[64, 128], help="widths to train (default 64 128)")
+    bb.add_argument("--seeds", type=int, default=2, help="seeds per width (default 2)")
+    bb.add_argument("--jobs", type=int, default=2, help="runs at a time, one thread each (default 2)")
+    bb.add_argument("--out", type=Path, help="also write bench_budget.parquet (+ config, provenance) here")
     bpl = bsub.add_parser("pipeline", help="time per rule family of a finished pipeline run")
     bpl.add_argument("overrides", nargs="*")
     bpl.add_argument("--results", type=Path, help="results folder of the run (default results/{scale})")
@@ -418,6 +426,22 @@ def _bench_physics(args, cfg, started) -> None:
         _metadata(args.out, cfg, started, args)
 
 
+def _bench_budget(args, cfg, started) -> None:
+    from .bench.budget import bench_budget, format_budget
+    from .io import atomic_path
+
+    runs = len(args.hidden) * args.seeds
+    print(f"bench budget: {runs} runs of {args.minutes:g} min, {args.jobs} at a time: about "
+          f"{args.minutes * -(-runs // max(args.jobs, 1)):.0f} min", file=sys.stderr, flush=True)
+    table = bench_budget(cfg, tuple(args.hidden), args.seeds, args.minutes, args.jobs,
+                         progress=lambda run: print(f"budget: {run} done", file=sys.stderr, flush=True))
+    if args.out:
+        with atomic_path(args.out / "bench_budget.parquet") as tmp:
+            table.to_parquet(tmp, index=False)
+        _metadata(args.out, cfg, started, args, name="bench_budget.provenance.json")
+    print(format_budget(table))
+
+
 def _bench_accuracy(args, cfg, started) -> None:
     from .bench.accuracy import bench_accuracy, plot_accuracy
     from .io import atomic_path
@@ -503,6 +527,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
             rows = bench_train(cfg, tuple(args.hidden))
             print(json.dumps(rows, indent=2) if args.json else format_train(rows))
+        elif args.bench == "budget":
+            _bench_budget(args, cfg, started)
         elif args.bench == "env":
             from .bench.env import bench_env, format_env
 

@@ -14,6 +14,7 @@ from efish.analysis.dynamics import (
     degenerate_reason,
     dynamics_table,
     effective_dimensionality,
+    food_decode_table,
     hidden_matrix,
     pca_variances,
     pcs_for_variance,
@@ -172,3 +173,25 @@ def test_plsc_by_distance_finds_sharing_only_where_planted():
     assert out["hi_cm"].tolist() == [10.0, 100.0, np.inf] and (out["reason"] == "").all()
     sparse = plsc_by_distance(h_a[:20], h_b[:20], np.full(20, 500.0), rng=0)
     assert sparse.loc[0, "reason"].startswith("need a T x D") and np.isnan(sparse.loc[0, "n_significant"])
+
+
+def test_food_decoding_splits_at_the_near_distance_and_scores_only_where_the_state_carries_food():
+    rng = np.random.default_rng(0)
+    x, groups = planted(rng, n_episodes=10, per=80)
+    dist = np.where(np.arange(len(x)) % 2 == 0, rng.uniform(0, 10, len(x)), rng.uniform(20, 100, len(x)))
+    dist[::7] = np.nan  # steps without food are in neither range
+    near = dist <= 10
+    # the hidden state carries the food distance (and bearing) only when food is near
+    bearing = rng.uniform(-np.pi, np.pi, len(x))
+    x = np.c_[x, np.where(near, dist, 0.0), np.where(near, np.cos(bearing), 0), np.where(near, np.sin(bearing), 0)]
+    hidden = pd.DataFrame(x, columns=[f"h_{i}" for i in range(x.shape[1])]).assign(
+        condition="control", episode=groups, agent=0, t=np.tile(np.arange(80), 10))
+    steps = hidden[["condition", "episode", "agent", "t"]].assign(dist_food_cm=dist, bearing_food_rad=bearing)
+    table = food_decode_table(hidden, steps, near_cm=10.0).set_index(["food", "target"])
+    assert table.loc[("near", "dist_food_cm"), "score"] > 0.9 and table.loc[("near", "bearing_food_rad"), "score"] > 0.9
+    assert abs(table.loc[("far", "dist_food_cm"), "score"]) < 0.15
+    assert abs(table.loc[("far", "bearing_food_rad"), "score"]) < 0.15
+    assert table.loc[("near", "dist_food_cm"), "n"] == np.sum(near)
+    assert table.loc[("far", "dist_food_cm"), "n"] == np.sum(dist > 10)
+    lacking = food_decode_table(hidden, steps.drop(columns="dist_food_cm"), near_cm=10.0)
+    assert lacking["reason"].iloc[0] == "steps table lacks column 'dist_food_cm'"

@@ -15,7 +15,7 @@ from ..helpers import panel_texts as texts
 
 FIG6 = [key for key in PANELS if key.startswith("fig6/")]
 #: Panels whose data no analysis table holds yet: they say so on themselves.
-NOT_ANALYSED = {"fig6/F"}
+NOT_ANALYSED: set[str] = set()
 
 
 def test_every_letter_of_spec_13_is_registered():
@@ -46,6 +46,19 @@ def test_decoding_without_any_score_says_why():
                           "reason": ["constant target"]})
     ax = draw("fig6/D", {"decoding": table})
     assert any("constant target" in t for t in texts(ax))
+
+
+def test_food_decoding_bars_pair_near_and_far_scores_per_variable():
+    table = pd.DataFrame({"condition": "control", "food": ["near", "near", "far", "far"],
+                          "target": ["dist_food_cm", "bearing_food_rad"] * 2, "score": [0.5, 0.3, -0.05, np.nan],
+                          "reason": ["", "", "", "fewer than 2 groups (episodes) with finite rows (1)"]})
+    ax = draw("fig6/F", {"food_decoding": table})
+    widths = sorted(p.get_width() for p in ax.patches if p.get_height() > 0 and np.isfinite(p.get_width()))
+    np.testing.assert_allclose(widths, [-0.05, 0.3, 0.5])
+    assert {t.get_text() for t in ax.get_yticklabels()} == {"food: distance", "food: bearing"}
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == ["near", "far"]
+    empty = draw("fig6/F", {"food_decoding": table.assign(score=np.nan)})
+    assert any("fewer than 2 groups" in t for t in texts(empty))
 
 
 def test_plsc_bars_are_the_table_values_and_an_empty_bin_says_n_a():
@@ -103,6 +116,10 @@ def test_power_near_far_draws_each_agent_episode_and_the_wilcoxon_stars():
             by_x.setdefault(round(x), []).append(y)
     assert sorted(by_x[0]) == [1.0, 2.0] and sorted(by_x[1]) == [3.0, 5.0]
     assert [t for t in texts(ax) if t.startswith("X")] == ["XNEAR"]
+    small = draw("fig6/I", {"power": power.assign(wideband_power=power["wideband_power"] * 1e-3), "tests": tests})
+    drawn = sorted(y for c in small.collections for _, y in c.get_offsets())
+    np.testing.assert_allclose(drawn, [1.0, 2.0, 3.0, 5.0])  # in units of 10^-3, which the label names
+    assert "10$^{-3}$" in small.get_ylabel()
     nan_row = pd.DataFrame([{"where": np.nan, "wideband_power": np.nan, "reason": "the rollout table lacks x"}])
     ax = draw("fig6/I", {"power": nan_row, "tests": tests})
     assert any("lacks x" in t for t in texts(ax))

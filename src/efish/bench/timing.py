@@ -2,8 +2,21 @@
 
 from __future__ import annotations
 
+import platform
 import time
+from pathlib import Path
 from typing import Callable
+
+
+def cpu_name() -> str:
+    """The CPU's model name (Linux ``/proc/cpuinfo``, else ``platform.processor()``), for quoting beside timings."""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown CPU"
 
 
 def best_time(fn: Callable[[], object], repeats: int, warmup: bool = True) -> float:

@@ -301,7 +301,7 @@ class BenchConfig:
 
 @dataclass
 class ScaleConfig:
-    """How big a run is: laptop, smoke or paper."""
+    """How big a run is: smoke, laptop, study or paper (config/scale/)."""
 
     name: str = param("laptop", "name of the scale, used in output paths")
     seeds: int = param(4, "foraging seeds trained (1..seeds)", lo=1)
@@ -377,7 +377,8 @@ class AnalysisConfig:
                                         lo=0.0, hi=1.0)
     claims_near_cm: float = param(10.0, "claims C21: a conspecific this close is near, cm", lo=0.0)
     claims_far_cm: float = param(100.0, "claims C21: a conspecific farther than this is far, cm", lo=0.0)
-    claims_food_near_cm: float = param(10.0, "claims C19: food this close is in range for decoding, cm", lo=0.0)
+    claims_food_near_cm: float = param(10.0, "food this close is in range when food variables are decoded near vs "
+                                       "far (dynamics food_decoding, Fig 6F, claim C19), cm", lo=0.0)
 
 
 # ----------------------------------------------------------------------- scene

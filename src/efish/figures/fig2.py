@@ -19,6 +19,9 @@ CONDITION_STYLE = {"electric": "-", "raycast": "--"}
 MAX_EPISODES_DRAWN = 8
 #: error-angle channel of the analysis tables -> receptor class of the style palette
 CHANNEL_RECEPTOR = {"morm": "mormyromast", "amp": "ampullary", "knollen": "knollenorgan"}
+#: the target's intrinsic and EOD dipoles share its axis, so the Ampullary and Knollenorgan error angles nearly
+#: coincide: distinct dashes and markers keep both lines visible where they overlap
+CHANNEL_STYLE = {"morm": ("-", "o"), "amp": ("--", "s"), "knollen": (":", "^")}
 
 
 def _palette() -> dict:
@@ -47,7 +50,7 @@ def scene(tables: dict[str, pd.DataFrame], ax) -> None:
     ax.set_xlabel("x (cm)")
     ax.set_ylabel("y (cm)")
     ax.set_title(f"Homing starts ({homer['episode'].nunique()} episodes)")
-    ax.legend(loc="upper right", fontsize=6, handletextpad=0.2)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=6, handletextpad=0.2, frameon=False)
 
 
 def trajectories(tables: dict[str, pd.DataFrame], ax) -> None:
@@ -70,13 +73,14 @@ def trajectories(tables: dict[str, pd.DataFrame], ax) -> None:
     absent = [c for c in CONDITION_STYLE if c not in set(steps["condition"])]
     note = ("no data: " + ", ".join(absent) + " not run; ") if absent else ""
     tortuosity = stars_for(tables["perception"], measure="tortuosity")
-    ax.text(0.02, 0.98, f"{note}tortuosity electric vs ray casting: {tortuosity}", transform=ax.transAxes,
+    # beside the arena, not on it: trajectories fill the whole square
+    ax.text(1.02, 0.70, f"{note}tortuosity,\nelectric vs\nray casting: {tortuosity}", transform=ax.transAxes,
             va="top", fontsize=6)
     ax.set_aspect("equal")
     ax.set_xlabel("x (cm)")
     ax.set_ylabel("y (cm)")
     ax.set_title("Homing trajectories")
-    ax.legend(loc="lower right", fontsize=6)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=6, frameon=False)
 
 
 def error_polar(tables: dict[str, pd.DataFrame], ax) -> None:
@@ -91,10 +95,12 @@ def error_polar(tables: dict[str, pd.DataFrame], ax) -> None:
     for channel, sub in hist.groupby("channel", sort=True):
         centres = (sub["bin_lo_rad"] + sub["bin_hi_rad"]).to_numpy() / 2
         closed = np.r_[centres, centres[:1]]
-        ax.plot(closed, np.r_[sub["density"].to_numpy(), sub["density"].iloc[:1]],
-                color=RECEPTOR_COLOURS[CHANNEL_RECEPTOR[channel]], label=CHANNEL_RECEPTOR[channel])
+        ax.plot(closed, np.r_[sub["density"].to_numpy(), sub["density"].iloc[:1]], CHANNEL_STYLE[channel][0],
+                color=RECEPTOR_COLOURS[CHANNEL_RECEPTOR[channel]], label=CHANNEL_RECEPTOR[channel], lw=1.0)
     ax.set_theta_zero_location("N")  # 0 = heading along the field line, at the top
-    ax.set_rlabel_position(112.5)
+    top = float(hist["density"].max())
+    ax.set_rticks(np.round(np.linspace(0, top, 4)[1:], 1))  # three radial labels, not a crowd at the centre
+    ax.set_rlabel_position(22.5)
     # units in the title: polar axis labels collide with the angle ticks and the legend
     ax.set_title("Error angle (deg): density (1/rad)")
     ax.tick_params(labelsize=6, pad=0)
@@ -112,7 +118,8 @@ def error_vs_time(tables: dict[str, pd.DataFrame], ax) -> None:
         return
     for channel, sub in table.groupby("channel", sort=True):
         colour = RECEPTOR_COLOURS[CHANNEL_RECEPTOR[channel]]
-        ax.plot(sub["t_norm_mid"], sub["mean_abs_err_rad"], "o-", ms=2.5, color=colour,
+        line, marker = CHANNEL_STYLE[channel]
+        ax.plot(sub["t_norm_mid"], sub["mean_abs_err_rad"], ls=line, marker=marker, ms=2.5, color=colour,
                 label=CHANNEL_RECEPTOR[channel])
         sem = sub["sem_abs_err_rad"].fillna(0)
         ax.fill_between(sub["t_norm_mid"], sub["mean_abs_err_rad"] - sem, sub["mean_abs_err_rad"] + sem,

@@ -25,6 +25,7 @@ from .style import (
     SELECTED_COLOUR,
     agent_colour,
     condition_palette,
+    corner_note,
     missing,
     stars_for,
 )
@@ -97,10 +98,6 @@ def _stat_text(stats: pd.DataFrame, symbol: str, **where) -> str:
         return f"test n/a: {row['reason']}"
     p = "p < 0.0001" if row["p"] < 1e-4 else f"p = {row['p']:.2g}"  # scipy returns p = 0 for a perfect rank match
     return f"{symbol} = {row['effect']:.2f}, {p} {stars_for(rows, **where)} (n = {int(row['n'])})"
-
-
-def _corner(ax, text: str) -> None:
-    ax.text(0.02, 0.98, text, transform=ax.transAxes, va="top", ha="left", fontsize=6)
 
 
 @cache
@@ -265,12 +262,17 @@ def idi_histogram_supplement(tables: dict[str, pd.DataFrame], ax) -> None:
     _log_axes(ax)
     edges = tables[f"idi_{SIGNALLING}"]
     ax.set_xlim(edges["bin_lo_ms"].min(), edges["bin_hi_ms"].max())  # the histograms' range (SPEC 12)
+    # the range spans more decades than panel C's: labels at 1, 2, 5 x 10^k would run into each other
+    from matplotlib.ticker import LogLocator
+
+    ax.xaxis.set_major_locator(LogLocator(subs=(1.0,)))
     ax.set_xlabel("inter-discharge interval (ms)")
     ax.set_ylabel("density (1/ms)")
     ax.set_title("IDI histograms")
     ax.legend(loc="upper right")
-    if note := _real_fish_note(tables[f"idi_{SIGNALLING}"]):
-        ax.text(0.02, 0.02, textwrap.fill(note, 30), transform=ax.transAxes, fontsize=6, color=NEUTRAL_COLOUR)
+    if note := _real_fish_note(tables[f"idi_{SIGNALLING}"]):  # under the legend, where the densities have fallen
+        ax.text(0.98, 0.72, textwrap.fill(note, 30), transform=ax.transAxes, ha="right", va="top", fontsize=6,
+                color=NEUTRAL_COLOUR)
 
 
 # ------------------------------------------------- E-J: EOD rate in context
@@ -376,8 +378,8 @@ def win_ratio_vs_size(tables: dict[str, pd.DataFrame], ax) -> None:
         return
     _size_scatter(ax, rows, "size", "win_ratio")
     ax.axhline(0.5, color=NEUTRAL_COLOUR, lw=0.5, ls=":")
-    _corner(ax, _stat_text(tables["size_tests"], "Spearman rho", measure="win_ratio"))
-    ax.set_ylim(-0.05, 1.15)
+    ax.set_ylim(-0.05, 1.05)
+    corner_note(ax, _stat_text(tables["size_tests"], "Spearman rho", measure="win_ratio"))
     ax.set_xlabel("body size")
     ax.set_ylabel("win ratio")
     ax.set_title("Win ratio vs size")
@@ -398,7 +400,7 @@ def food_vs_size(tables: dict[str, pd.DataFrame], ax) -> None:
             ax.plot(xs, f["intercept"] + f["effect"] * xs, color=colours[condition],
                     label=f"slope {f['effect']:.2g}, R$^2$ {f['r2']:.2f}, {f['stars']}")
         else:
-            _corner(ax, f"OLS n/a: {f['reason']}")
+            corner_note(ax, f"OLS n/a: {f['reason']}")
     ax.set_xlabel("body size")
     ax.set_ylabel("food eaten per episode")
     ax.set_title(f"Food vs size ({rows[['condition', 'episode']].drop_duplicates().shape[0]} episodes)")
@@ -413,7 +415,7 @@ def theil_vs_size_inequality(tables: dict[str, pd.DataFrame], ax) -> None:
     if rows is None:
         return
     _size_scatter(ax, rows, "size_theil_t", "theil_t")
-    _corner(ax, _stat_text(tables["size_tests"], "Spearman rho", measure="theil_t"))
+    corner_note(ax, _stat_text(tables["size_tests"], "Spearman rho", measure="theil_t"))
     ax.set_xlabel("size inequality (Theil T of sizes)")
     ax.set_ylabel("food inequality (Theil T)")
     ax.set_title(f"Food vs size inequality ({len(rows)} episodes)")
@@ -427,8 +429,7 @@ def eod_rate_vs_size(tables: dict[str, pd.DataFrame], ax) -> None:
         return
     rows = rows.assign(rate_hz=rows["eod_probability"] * _assay_config(FORAGING).env.fps)
     _size_scatter(ax, rows, "size", "rate_hz")
-    _corner(ax, _stat_text(tables["size_tests"], "Spearman rho", measure="eod_probability"))
-    ax.set_ylim(top=ax.get_ylim()[1] * 1.15)  # room for the test above the points
+    corner_note(ax, _stat_text(tables["size_tests"], "Spearman rho", measure="eod_probability"))
     ax.set_xlabel("body size")
     ax.set_ylabel("EOD rate (Hz)")
     ax.set_title("EOD rate vs size")
@@ -444,8 +445,7 @@ def rate_advantage(tables: dict[str, pd.DataFrame], ax) -> None:
     ax.axhline(0, color=NEUTRAL_COLOUR, lw=0.5, ls=":")
     ax.axvline(0, color=NEUTRAL_COLOUR, lw=0.5, ls=":")
     stats = tables["rate_tests"]
-    _corner(ax, "\n".join(_stat_text(stats, "Spearman rho", group=c) for c in sorted(rows["condition"].unique())))
-    ax.set_ylim(top=ax.get_ylim()[1] + 0.2 * np.ptp(ax.get_ylim()))
+    corner_note(ax, "\n".join(_stat_text(stats, "Spearman rho", group=c) for c in sorted(rows["condition"].unique())))
     ax.set_xlabel("size advantage (own - partner)")
     ax.set_ylabel("EOD-rate advantage (Hz)")
     ax.set_title(f"Rate vs size advantage ({len(rows)} pairs)")

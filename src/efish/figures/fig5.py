@@ -27,6 +27,7 @@ from .style import (
     annotate_stars,
     assay_conditions,
     box_strip,
+    corner_note,
     finite,
     missing,
     stars_for,
@@ -207,7 +208,8 @@ def trajectory_panel(condition: str) -> Callable[[Tables, object], None]:
             ax.plot(path["x_cm"].iloc[0], path["y_cm"].iloc[0], "o", color=colour, ms=3.5, mec="black", mew=0.4)
             ate = path[path["ate"].astype(bool)]
             ax.plot(ate["x_cm"], ate["y_cm"], "*", color=colour, ms=5, mec="black", mew=0.3, ls="none")
-        ax.legend(loc="lower left", fontsize=6, title="o start, * ate", title_fontsize=6)
+        ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=6, title="o start, * ate", title_fontsize=6,
+                  frameon=False)  # beside the arena: the paths cover all of it
         ax.set_title(f"{_class_label(condition)}, episode {int(run['episode'].iloc[0])}")
 
     draw.__doc__ = f"Panel: paths of A and B in the first {condition} episode of the one-patch assay."
@@ -351,7 +353,7 @@ def size_difference(measure: str) -> Callable[[Tables, object], None]:
             stars = stars_for(test, group=role)
             prefix = f"{cond}: " if hue else ""
             notes.append(f"{prefix}median {median:+.2f} {stars}" if np.isfinite(median) else f"{prefix}{stars}")
-        ax.text(0.02, 0.98, "\n".join(notes), transform=ax.transAxes, va="top", fontsize=6)
+        corner_note(ax, "\n".join(notes))
         ax.set_xlim(-1, 1)
         ax.set_xlabel(f"{role} size - {other} size")
         ax.set_ylabel("bouts" if measure == "chase" else "bites")

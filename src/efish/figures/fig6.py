@@ -22,12 +22,14 @@ from ..analysis.dynamics_tests import smaller_larger
 from ..config.schema import AnalysisConfig
 from .panel import Panel, Tables
 from .style import (
+    FOOD_RANGE_COLOURS,
     NEUTRAL_COLOUR,
     RECEPTOR_COLOURS,
     annotate_stars,
     box_strip,
     condition_order,
     condition_palette,
+    corner_note,
     group_size_colours,
     mean_lines,
     missing,
@@ -87,7 +89,7 @@ def deff_vs_group_size(tables: Tables, ax) -> None:
             row = tests[tests["group"] == key]
             rho = float(row["effect"].iloc[0]) if len(row) else np.nan
             notes.append(f"{state}: " + (f"rho {rho:+.2f} " if np.isfinite(rho) else "") + stars_for(row))
-        ax.text(0.02, 0.98, "\n".join(notes), transform=ax.transAxes, va="top", fontsize=6)
+        corner_note(ax, "\n".join(notes))
         ax.set_xlabel("group size N (agents)")
         ax.set_ylabel("D_eff of the hidden state")
         ax.set_title("Dimensionality vs group size")
@@ -112,8 +114,9 @@ def subsampling_curves(tables: Tables, ax) -> None:
     ax.legend(loc="upper left", fontsize=6, ncols=1)
 
 
-def decoding_bars(assay: str, title: str):
-    """A draw function: decoding score per target (sorted, best on top), one bar colour per condition."""
+def decoding_bars(assay: str, title: str, control: str | None = None):
+    """A draw function: decoding score per target (sorted, best on top), one bar colour per condition
+    (``control``, default the assay's first condition, grey)."""
     def draw(tables: Tables, ax) -> None:
         import seaborn as sns
 
@@ -125,9 +128,9 @@ def decoding_bars(assay: str, title: str):
             return
         scored = scored.assign(label=scored["target"].map(lambda t: TARGET_LABELS.get(t, t)))
         ranking = scored.groupby("label")["score"].mean().sort_values(ascending=False).index.tolist()
-        conditions = condition_order(assay, scored["condition"])
+        conditions = condition_order(assay, scored["condition"], control)
         sns.barplot(data=scored, x="score", y="label", hue="condition", order=ranking, hue_order=conditions,
-                    palette=condition_palette(conditions), orient="h", legend=len(conditions) > 1, ax=ax)
+                    palette=condition_palette(conditions, control), orient="h", legend=len(conditions) > 1, ax=ax)
         ax.axvline(0.0, color="black", lw=0.5)
         ax.set_xlabel("decoding score (R$^2$ - baseline R$^2$)")
         ax.set_ylabel("decoded variable")
@@ -139,14 +142,27 @@ def decoding_bars(assay: str, title: str):
     return draw
 
 
-def needs_analysis(what: str):
-    """A draw function for a panel whose data the dynamics analysis does not write yet: it says which."""
-    def draw(tables: Tables, ax) -> None:
-        missing(ax, what)
-        ax.set_xlabel("")
-        ax.set_ylabel("")
+def food_decoding_bars(tables: Tables, ax) -> None:
+    """Panel F: decoding score of the food variables with the nearest food in receptor range (near) and beyond it
+    (far), one bar pair per variable, from the dynamics food_decoding table of wide2 (conditions pooled by mean)."""
+    import seaborn as sns
 
-    return draw
+    table = tables["food_decoding"]
+    scored = table[np.isfinite(pd.to_numeric(table.get("score", pd.Series(dtype=float)), errors="coerce"))]
+    if scored.empty:
+        reasons = [r for r in table.get("reason", pd.Series(dtype=str)).astype(str) if r and r != "nan"]
+        missing(ax, f"no food decoding score in wide2: {reasons[0] if reasons else 'empty table'}")
+        return
+    scored = scored.assign(label=scored["target"].map(lambda t: TARGET_LABELS.get(t, t)))
+    ranges = [r for r in FOOD_RANGE_COLOURS if r in set(scored["food"])]
+    sns.barplot(data=scored, x="score", y="label", hue="food", hue_order=ranges, palette=FOOD_RANGE_COLOURS,
+                orient="h", errorbar=None, ax=ax)
+    ax.axvline(0.0, color="black", lw=0.5)
+    near = AnalysisConfig().claims_food_near_cm
+    ax.legend(title=f"food (near: <= {near:g} cm)", fontsize=6, title_fontsize=6, loc="best")
+    ax.set_xlabel("decoding score (R$^2$ - baseline R$^2$)")
+    ax.set_ylabel("decoded variable")
+    ax.set_title("Two agents: food near vs far")
 
 
 def bin_label(lo: float, hi: float) -> str:
@@ -204,10 +220,21 @@ def _pair_bracket(ax, frame: pd.DataFrame, y: str, tests: pd.DataFrame, measure:
     ax.set_ylim(top=top * 1.3)
 
 
+def _power_scaled(frame: pd.DataFrame) -> tuple[pd.DataFrame, str]:
+    """``wideband_power`` in units of a power of ten that brings its largest value to 1-10, and the axis label
+    naming the unit: matplotlib's offset text (``1e-3``) would sit on the title."""
+    values = pd.to_numeric(frame["wideband_power"], errors="coerce").to_numpy(float)
+    top = np.nanmax(values) if np.isfinite(values).any() else np.nan
+    exponent = int(np.floor(np.log10(top))) if np.isfinite(top) and top > 0 else 0
+    if exponent == 0:
+        return frame, POWER_LABEL
+    return frame.assign(wideband_power=values / 10.0 ** exponent), f"wideband power (10$^{{{exponent}}}$ / Hz)"
+
+
 def power_near_far(tables: Tables, ax) -> None:
     """Panel I: wideband power of each agent-episode over its steps with the conspecific near vs far, pairs joined,
     with the Wilcoxon stars of power_tests."""
-    frame, order = tables["power"], ["near", "far"]
+    (frame, label), order = _power_scaled(tables["power"]), ["near", "far"]
     if not box_strip(ax, frame, "where", "wideband_power", order, condition_palette(order)):
         return
     wide = frame.pivot_table(index=["condition", "episode", "agent"], columns="where", values="wideband_power")
@@ -217,21 +244,19 @@ def power_near_far(tables: Tables, ax) -> None:
     a = AnalysisConfig()
     ax.set_xticks([0, 1], [f"near (<= {a.claims_near_cm:g} cm)", f"far (> {a.claims_far_cm:g} cm)"])
     ax.set_xlabel("nearest conspecific (wide2)")
-    ax.set_ylabel(POWER_LABEL)
-    ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 3))
+    ax.set_ylabel(label)
     ax.set_title("Power vs conspecific distance")
 
 
 def power_by_size(tables: Tables, ax) -> None:
     """Panel J: wideband power of the smallest agent of each episode vs the others (equal sizes dropped), with the
     Mann-Whitney stars of power_tests."""
-    frame = smaller_larger(tables["dims"], tables["episodes"])
+    frame, label = _power_scaled(smaller_larger(tables["dims"], tables["episodes"]))
     order = ["smaller", "larger"]
     if box_strip(ax, frame, "role", "wideband_power", order, dict(zip(order, size_class_colours(2), strict=True))):
         _pair_bracket(ax, frame, "wideband_power", tables["tests"], "size")
         ax.set_xlabel("agent within its episode (wide2)")
-        ax.set_ylabel(POWER_LABEL)
-        ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 3))
+        ax.set_ylabel(label)
         ax.set_title("Power vs size")
 
 
@@ -255,7 +280,7 @@ PANELS = [
           "analysis.subsample_draws draws each) against the fraction kept, mean over draws and agent-episodes, per "
           "group size (colour) and Knollenorgan state (dashed: off), groupsize assay, "
           "analysis/dynamics/groupsize/subsampling."),
-    Panel("fig6", "D", decoding_bars("homing", "Homing: decoding"), {"decoding": _dyn("homing", "decoding")},
+    Panel("fig6", "D", decoding_bars("homing", "Homing: decoding", control="raycast"), {"decoding": _dyn("homing", "decoding")},
           "Cross-validated linear decoding of step variables from the homer's hidden state (score = held-out R^2 "
           "minus that of the training mean; folds grouped by episode), electric and ray-casting homing policies, "
           "analysis/dynamics/homing/decoding; targets without a score (e.g. no food in the arena) are left out. "
@@ -263,10 +288,10 @@ PANELS = [
     Panel("fig6", "E", decoding_bars("wide2", "Two agents: decoding"), {"decoding": _dyn("wide2", "decoding")},
           "Decoding score per step variable from the hidden state of both agents of the wide2 assay (160 x 40 cm), "
           "ranked best first, analysis/dynamics/wide2/decoding; targets without a score are left out."),
-    Panel("fig6", "F", needs_analysis("no food-near / food-far split\nin analysis/dynamics/wide2/decoding"),
-          {"decoding": _dyn("wide2", "decoding")},
-          "Food variables decoded when food is near vs far (wide2): the dynamics analysis does not split decoding "
-          "by food distance yet, so the panel says so instead of drawing."),
+    Panel("fig6", "F", food_decoding_bars, {"food_decoding": _dyn("wide2", "food_decoding")},
+          "Decoding score of the food variables (distance and bearing of the nearest pellet) from the hidden states "
+          "of the wide2 agents on the steps with that pellet within analysis.claims_food_near_cm (near, in receptor "
+          "range) and beyond it (far); analysis/dynamics/wide2/food_decoding. Claim C19 tests near > far."),
     Panel("fig6", "G", plsc_bars("s_1", "first PLSC singular value", "PLSC: first component"),
           {"plsc": _dyn("wide2", "plsc")},
           "Partial least squares correlation of the two wide2 agents' z-scored hidden states per pair-distance bin "

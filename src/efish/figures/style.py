@@ -27,6 +27,8 @@ CONDITION_COLOURS = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56
 SIZE_CLASS_CMAP = "viridis_r"
 ONEPATCH_CLASS_COLOURS = {"A_lt_B": "#440154", "A_eq_B": "#21918c", "A_gt_B": "#b89b00",
                           "A_alone": "#7f7f7f", "B_alone": "#bfbfbf"}
+#: Decoding with the nearest food in receptor range (near) or beyond it (far), Fig 6F.
+FOOD_RANGE_COLOURS = {"near": "#009E73", "far": "#7f7f7f"}
 #: Sequential colour map of every heat map (bite matrices, field maps use their own diverging one).
 HEATMAP_CMAP = "rocket_r"
 FIELD_CMAP = "RdBu_r"
@@ -94,6 +96,16 @@ def panel_style():
 
     with plt.rc_context(sns.axes_style("ticks")), plt.rc_context(RC_PARAMS):
         yield plt
+
+
+def corner_note(ax, text: str, headroom: float = 0.09) -> None:
+    """A statistic's text in the top-left corner, with room made above the data (``headroom`` of the y-range
+    per line) so that no point hides under it. Call it after the data is drawn and any y-limits are set."""
+    lines = text.count("\n") + 1
+    lo, hi = ax.get_ylim()
+    if ax.get_yscale() == "linear":
+        ax.set_ylim(lo, hi + headroom * lines * (hi - lo))
+    ax.text(0.02, 0.98, text, transform=ax.transAxes, va="top", ha="left", fontsize=6)
 
 
 def missing(ax, what: str) -> None:

@@ -43,14 +43,22 @@ def _per_seed(ax, tables: dict[str, pd.DataFrame], column: str, colour: str | No
     if column not in metrics or not metrics[column].notna().any():
         return False
     selected = _selected_seed(tables)
+    others_labelled = False
     for seed, m in metrics.groupby("seed"):
         m = m.dropna(subset=[column])
         chosen = seed == selected
         line_colour = colour or (SELECTED_COLOUR if chosen else NEUTRAL_COLOUR)
+        if chosen:
+            line_label = label or f"seed {seed} (selected)"
+        elif not others_labelled and (colour is None or selected is None):
+            line_label = label or ("other seeds" if selected is not None else "every seed")
+            others_labelled = True  # one legend entry for all the grey lines
+        else:
+            line_label = None
         ax.plot(m["env_steps"], m[column], color=line_colour, alpha=0.15, lw=0.6)
         ax.plot(m["env_steps"], ema(m[column]), color=line_colour, alpha=1.0 if chosen else 0.6,
                 lw=1.2 if chosen else 0.8, zorder=3 if chosen else 2, ls="-" if chosen or not colour else "--",
-                label=(label or f"seed {seed}") if chosen or (colour and seed == metrics["seed"].min()) else None)
+                label=line_label)
     ax.set_xlabel("env steps")
     return True
 
