@@ -427,12 +427,13 @@ def _bench_physics(args, cfg, started) -> None:
 
 
 def _bench_budget(args, cfg, started) -> None:
-    from .bench.budget import bench_budget, format_budget
+    from .bench.budget import bench_budget, check_budget, format_budget
     from .io import atomic_path
 
+    check_budget(tuple(args.hidden), args.seeds, args.minutes, args.jobs)  # before announcing the runs
     runs = len(args.hidden) * args.seeds
     print(f"bench budget: {runs} runs of {args.minutes:g} min, {args.jobs} at a time: about "
-          f"{args.minutes * -(-runs // max(args.jobs, 1)):.0f} min", file=sys.stderr, flush=True)
+          f"{args.minutes * -(-runs // args.jobs):.0f} min", file=sys.stderr, flush=True)
     table = bench_budget(cfg, tuple(args.hidden), args.seeds, args.minutes, args.jobs,
                          progress=lambda run: print(f"budget: {run} done", file=sys.stderr, flush=True))
     if args.out:

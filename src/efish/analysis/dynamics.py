@@ -297,28 +297,19 @@ FOOD_DECODE_COLUMNS = ["condition", "food", *DECODE_COLUMNS[1:]]
 
 def food_decode_table(hidden: pd.DataFrame, steps: pd.DataFrame, near_cm: float,
                       folds: int = DEFAULTS.decode_folds) -> pd.DataFrame:
-    """:func:`decode` of the food variables on the steps with the nearest food within ``near_cm`` (``food`` =
-    "near": in receptor range) and beyond it ("far"), per condition (Fig 6F, claim C19).
+    """:func:`decode_table` of the food variables on the steps with the nearest food within ``near_cm`` (``food``
+    = "near": in receptor range) and on those beyond it ("far"), per condition (Fig 6F, claim C19).
 
-    Steps without food (NaN distance) are in neither. One row per condition,
-    range and food target (columns :data:`FOOD_DECODE_COLUMNS`); a range with
-    fewer than 2 episodes is NaN with the reason :func:`decode` gives.
+    Steps without food (NaN distance) are in neither. One row per range,
+    condition and food target (columns :data:`FOOD_DECODE_COLUMNS`); a range
+    with fewer than 2 episodes is NaN with the reason :func:`decode` gives.
     """
     if "dist_food_cm" not in steps.columns:
         return nan_frame("steps table lacks column 'dist_food_cm'").reindex(columns=FOOD_DECODE_COLUMNS)
-    present = [c for c in FOOD_TARGETS if c in steps.columns]
-    joined = _with_steps(hidden, steps, present)
-    h, rows = units(hidden), []
-    for cond, sub in joined.groupby("condition", sort=True):
-        for food, part in (("near", sub[sub["dist_food_cm"] <= near_cm]), ("far", sub[sub["dist_food_cm"] > near_cm])):
-            x = part[h].to_numpy(np.float64)
-            for target, circular in FOOD_TARGETS.items():
-                res = (decode(x, part[target].to_numpy(np.float64), part["episode"].to_numpy(), circular, folds)
-                       if target in present else {"reason": f"steps table lacks column {target!r}"})
-                rows.append({"condition": cond, "food": food, "target": target, "circular": circular, **res})
-    if not rows:
-        return nan_frame("no hidden row matches a step").reindex(columns=FOOD_DECODE_COLUMNS)
-    return pd.DataFrame(rows, columns=FOOD_DECODE_COLUMNS)
+    dist = steps["dist_food_cm"]
+    parts = [decode_table(hidden, steps[in_range], FOOD_TARGETS, folds).assign(food=food)
+             for food, in_range in (("near", dist <= near_cm), ("far", dist > near_cm))]
+    return pd.concat(parts, ignore_index=True)[FOOD_DECODE_COLUMNS]
 
 
 def plsc_table(hidden: pd.DataFrame, steps: pd.DataFrame, agents: tuple[int, int] = (0, 1),

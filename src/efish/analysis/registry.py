@@ -206,8 +206,8 @@ def _onepatch(t: Tables, cfg: EfishConfig) -> Tables:
 
 # --------------------------------------------------------------- dynamics
 def _dynamics(t: Tables, cfg: EfishConfig) -> Tables:
-    """Hidden-state dimensionality, power, unit subsampling, decoding (also of food near and far), PLSC of agents 0 and 1, and the tests of
-    D_eff against group size and of wideband power by context (Fig 6)."""
+    """Hidden-state dimensionality, power, unit subsampling, decoding (also of food near and far), PLSC of agents
+    0 and 1, and the tests of D_eff against group size and of wideband power by context (Fig 6)."""
     a, hidden, steps = cfg.analysis, t["hidden"], t["steps"]
     rng = np.random.default_rng(a.seed)
     dims = dynamics_table(hidden, a.variance_fraction, a.spectrogram_window, a.spectrogram_overlap, cfg.env.fps)
@@ -251,8 +251,8 @@ ANALYSES: dict[str, Analysis] = {a.name: a for a in [
     Analysis("onepatch", _onepatch, ("steps",), ("onepatch", "bot"),
              ("food_time_course", "reach_rates", "role_tests", "reach_tests"), ("role_tests", "reach_tests")),
     Analysis("dynamics", _dynamics, ("hidden", "steps"), ("patchy4", "wide2", "homing", "groupsize", "square2"),
-             ("dimensionality", "subsampling", "decoding", "food_decoding", "plsc", "condition_tests", "size_tests", "power_near_far",
-              "power_tests"), ("condition_tests", "size_tests", "power_tests")),
+             ("dimensionality", "subsampling", "decoding", "food_decoding", "plsc", "condition_tests", "size_tests",
+              "power_near_far", "power_tests"), ("condition_tests", "size_tests", "power_tests")),
 ]}
 
 

@@ -74,15 +74,20 @@ def steps_at(run: pd.DataFrame, seconds: float) -> int:
     return int(done["env_steps"].iloc[-1]) if len(done) else 0
 
 
+def check_budget(hiddens: tuple[int, ...], seeds: int, minutes: float, jobs: int) -> None:
+    """One ValueError line unless minutes > 0, seeds >= 1, jobs >= 1 and every width >= 1."""
+    if minutes <= 0 or seeds < 1 or jobs < 1 or not hiddens or min(hiddens) < 1:
+        raise ValueError(f"bench budget needs minutes > 0, seeds >= 1, jobs >= 1 and widths >= 1; got "
+                         f"minutes={minutes}, seeds={seeds}, jobs={jobs}, widths={list(hiddens)}")
+
+
 def bench_budget(cfg: EfishConfig, hiddens: tuple[int, ...], seeds: int, minutes: float, jobs: int = 2,
                  progress=None) -> pd.DataFrame:
     """Train every (width, seed) for ``minutes``; one row per run and checkpoint time (budget / seeds and budget).
 
     Columns: hidden, seed, fraction (of the budget), wall_s, env_steps, episode_return.
     """
-    if minutes <= 0 or seeds < 1 or jobs < 1 or not hiddens or min(hiddens) < 1:
-        raise ValueError(f"bench budget needs minutes > 0, seeds >= 1, jobs >= 1 and widths >= 1; got "
-                         f"minutes={minutes}, seeds={seeds}, jobs={jobs}, widths={list(hiddens)}")
+    check_budget(hiddens, seeds, minutes, jobs)
     seconds = 60.0 * minutes
     train_for(cfg, min(hiddens), 1, 0.0)  # one update here first compiles the numba kernels for every run
     runs = [(h, s) for h in hiddens for s in range(1, seeds + 1)]

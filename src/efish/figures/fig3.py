@@ -405,6 +405,8 @@ def food_vs_size(tables: dict[str, pd.DataFrame], ax) -> None:
     ax.set_ylabel("food eaten per episode")
     ax.set_title(f"Food vs size ({rows[['condition', 'episode']].drop_duplicates().shape[0]} episodes)")
     if ax.get_legend_handles_labels()[0]:
+        lo, hi = ax.get_ylim()
+        ax.set_ylim(lo, hi + 0.12 * (hi - lo))  # room for the fit legend above the points
         ax.legend(loc="upper left")
 
 

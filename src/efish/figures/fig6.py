@@ -93,7 +93,7 @@ def deff_vs_group_size(tables: Tables, ax) -> None:
         ax.set_xlabel("group size N (agents)")
         ax.set_ylabel("D_eff of the hidden state")
         ax.set_title("Dimensionality vs group size")
-        ax.legend(loc="lower right")
+        ax.legend(loc="upper center")  # the room corner_note made above the points
 
 
 def subsampling_curves(tables: Tables, ax) -> None:
