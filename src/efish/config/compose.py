@@ -3,19 +3,29 @@
 Uses Hydra's compose API only: no working-directory change, no timestamped
 output folders. Every failure becomes a :class:`ConfigError` whose message is
 one line naming the key.
+
+A composition costs about 0.3 s, and a workflow parse composes a few dozen
+(every job on a cluster parses the workflow again), so successful results are
+kept on disk (:func:`cache_folder`), keyed by the overrides and a digest of
+everything a composition reads: every file of the config tree, the sources of
+this package's config modules and the Hydra and OmegaConf versions. Any edit
+to one of them gives new keys; failures are never cached.
 """
 
 from __future__ import annotations
 
 import hashlib
 import os
+import pickle
 import re
 from pathlib import Path
-from typing import Sequence
+from collections.abc import Callable, Sequence
+from typing import TypeVar
 
 from .schema import ConfigError, EfishConfig, validate
 
 _SCHEMA_REGISTERED = False
+T = TypeVar("T")
 
 
 def config_dir() -> Path:
@@ -32,6 +42,53 @@ def config_dir() -> Path:
         if (path / "config.yaml").is_file():
             return path
     raise ConfigError(f"no config tree found (looked in {', '.join(map(str, candidates))}); set EFISH_CONFIG_DIR")
+
+
+def cache_folder() -> Path | None:
+    """Where composed configs are cached: ``$EFISH_CACHE_DIR/compose`` (``off`` or empty: no cache), else
+    ``~/.cache/efish/compose``."""
+    env = os.environ.get("EFISH_CACHE_DIR")
+    if env is not None and env.strip().lower() in ("", "off"):
+        return None
+    return (Path(env) if env else Path.home() / ".cache" / "efish") / "compose"
+
+
+def _inputs_digest(tree: Path) -> str:
+    """Digest of everything a composition reads: the config tree's files, this package's config sources and the
+    Hydra and OmegaConf versions. Computed afresh each time (a few ms): a tree edited between two compositions of
+    one process must not be served the first result."""
+    import hydra
+    import omegaconf
+
+    digest = hashlib.sha256(f"hydra {hydra.__version__} omegaconf {omegaconf.__version__}".encode())
+    sources = sorted(Path(__file__).parent.glob("*.py"))
+    for path in [*sorted(p for p in tree.rglob("*") if p.is_file()), *sources]:
+        digest.update(str(path.relative_to(tree if path.is_relative_to(tree) else path.parent)).encode())
+        digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+def _cached(kind: str, overrides: Sequence[str], build: Callable[[], T], *extra: object) -> T:
+    """``build()``, or its earlier result for the same ``kind``, overrides, ``extra`` and config inputs."""
+    folder = cache_folder()
+    if folder is None:
+        return build()
+    tree = config_dir().resolve()
+    key = hashlib.sha256(repr((kind, str(tree), list(overrides), extra, _inputs_digest(tree))).encode()).hexdigest()
+    path = folder / f"{key}.pkl"
+    try:
+        return pickle.loads(path.read_bytes())
+    except Exception:  # absent, half-written by a killed process, or from an incompatible build: compose again
+        pass
+    value = build()
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+        tmp.write_bytes(pickle.dumps(value))
+        os.replace(tmp, path)  # atomic: a concurrent reader sees the whole file or none
+    except OSError:  # a read-only home is no reason to fail a composition
+        pass
+    return value
 
 
 def _register_schemas() -> None:
@@ -86,6 +143,13 @@ def compose_variants(overrides: Sequence[str], variants: dict[str, Sequence[str]
     composed in full. Errors are one :class:`ConfigError` line naming the
     variant (``<label> <name>: ...``).
     """
+    frozen = None if variants is None else {k: list(v) for k, v in variants.items()}
+    return _cached("variants", overrides, lambda: _compose_variants(overrides, variants, label), frozen, label)
+
+
+def _compose_variants(overrides: Sequence[str], variants: dict[str, Sequence[str]] | None,
+                      label: str) -> dict[str, EfishConfig]:
+    """:func:`compose_variants` without the cache."""
     from hydra.core.override_parser.overrides_parser import OverridesParser
 
     base = _hydra_compose(overrides)
@@ -128,7 +192,7 @@ def compose(overrides: Sequence[str] = ()) -> EfishConfig:
     >>> cfg.physics.image_order
     2
     """
-    return _to_config(_hydra_compose(overrides))
+    return _cached("config", overrides, lambda: _to_config(_hydra_compose(overrides)))
 
 
 def one_line_message(exc: BaseException) -> str:
