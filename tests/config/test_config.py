@@ -179,3 +179,26 @@ def test_a_bad_variant_is_one_line_naming_it():
 
     with pytest.raises(ConfigError, match=r"^condition x: unknown config key 'env.nonsense'$"):
         compose_variants(["assay=mute"], {"x": ["env.nonsense=1"]}, label="condition")
+
+
+def test_the_compose_cache_serves_equal_configs_and_follows_every_edit_of_the_tree(tmp_path, monkeypatch):
+    import importlib
+    import shutil
+
+    composer = importlib.import_module("efish.config.compose")  # the module; efish.config.compose is the function
+
+    tree = tmp_path / "config"
+    shutil.copytree(composer.config_dir(), tree)
+    monkeypatch.setenv("EFISH_CONFIG_DIR", str(tree))
+    monkeypatch.setenv("EFISH_CACHE_DIR", str(tmp_path / "cache"))
+    first = composer.compose(["scale=smoke"])
+    assert list((tmp_path / "cache" / "compose").glob("*.pkl"))  # kept on disk
+    again = composer.compose(["scale=smoke"])
+    assert again == first and again is not first  # a fresh object: callers may change it
+    smoke = tree / "scale" / "smoke.yaml"
+    assert "\n  seeds: 2\n" in smoke.read_text()
+    smoke.write_text(smoke.read_text().replace("\n  seeds: 2\n", "\n  seeds: 7\n"))
+    edited = composer.compose(["scale=smoke"])
+    assert edited.scale.seeds == 7 and first.scale.seeds != 7  # an edit of the tree gives a new key
+    monkeypatch.setenv("EFISH_CACHE_DIR", "off")
+    assert composer.cache_folder() is None and composer.compose(["scale=smoke"]).scale.seeds == 7
