@@ -202,3 +202,6 @@ def test_the_compose_cache_serves_equal_configs_and_follows_every_edit_of_the_tr
     assert edited.scale.seeds == 7 and first.scale.seeds != 7  # an edit of the tree gives a new key
     monkeypatch.setenv("EFISH_CACHE_DIR", "off")
     assert composer.cache_folder() is None and composer.compose(["scale=smoke"]).scale.seeds == 7
+    monkeypatch.delenv("EFISH_CACHE_DIR")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))  # without it: beside numba's kernels
+    assert composer.cache_folder() == tmp_path / "xdg" / "efish" / "compose"

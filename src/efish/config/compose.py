@@ -46,11 +46,12 @@ def config_dir() -> Path:
 
 def cache_folder() -> Path | None:
     """Where composed configs are cached: ``$EFISH_CACHE_DIR/compose`` (``off`` or empty: no cache), else
-    ``~/.cache/efish/compose``."""
+    ``$XDG_CACHE_HOME/efish/compose`` (``~/.cache`` without it), beside numba's kernels."""
     env = os.environ.get("EFISH_CACHE_DIR")
     if env is not None and env.strip().lower() in ("", "off"):
         return None
-    return (Path(env) if env else Path.home() / ".cache" / "efish") / "compose"
+    base = Path(env) if env else Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "efish"
+    return base / "compose"
 
 
 def _inputs_digest(tree: Path) -> str:
