@@ -37,8 +37,9 @@ def random_large_batch(seed: int) -> SnapshotBatch:
 
 
 @pytest.mark.parametrize("seed", range(4))
-@pytest.mark.parametrize("overrides", [(), ("sensors.mormyromast.g_self=0",), ("physics.image_order=2",)],
-                         ids=["default", "cons-only", "order2"])
+@pytest.mark.parametrize("overrides", [(), ("sensors.mormyromast.g_self=0",), ("physics.image_order=2",),
+                                       ("physics.tolerance=1e-2",)],
+                         ids=["default", "cons-only", "order2", "loose"])  # loose: most pellets culled at every agent
 def test_measured_error_never_exceeds_the_reported_bound(seed, overrides):
     cfg = cfg_with("physics.error_bound=true", *overrides)
     batch = random_large_batch(seed)

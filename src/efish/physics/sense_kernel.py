@@ -1,8 +1,9 @@
 """Per-batch and per-agent assembly of raw readings in numba: exact and interpolated sources, Knollenorgans.
 
 :func:`sense_batch_kernel` names its inputs and runs :func:`sense_arenas`: per
-arena :func:`fill_bodies` (agents, live pellets, padding), the induced moments and
-their sum T1 (:func:`t1_moments`), the source list (far pellet images shared
+arena :func:`fill_bodies` (agents, live pellets, padding), in shared mode the
+pellets every agent culls dropped (:func:`drop_culled_bodies`), the induced
+moments and their sum T1 (:func:`t1_moments`), the source list (far pellet images shared
 between agents by :func:`efish.physics.sources.share_far_sources`) and
 :func:`knollenorgan_env`; per agent the agent's Mormyromast moments and
 :func:`sense_agent` (culling and bucketing in
@@ -348,27 +349,89 @@ def fill_bodies(b, batch, c, flags, bodies):
 
 
 @njit(cache=True, error_model="numpy")
-def t1_moments(arena, nb, fill, c, bodies):
-    """T1, the sum over emitters of the moments induced in the first ``nb`` bodies, in rows B_T1X, B_T1Y.
+def t1_moments(nb, fill, c, bodies, n):
+    """T1, the sum over the ``n`` agents (silent ones induce 0) of the moments induced in the first ``nb`` bodies,
+    in rows B_T1X, B_T1Y.
 
-    Every agent weighs T1 alike in shared mode; it is filled there only (``fill``,
-    else 0). Returns the largest Mormyromast weight of any agent (0 unless filled).
+    Every agent weighs T1 alike in shared mode; it is filled there only (``fill``, else 0).
     Loops, not array expressions: a kernel that cannot raise keeps no reference counts.
     """
-    body, p_ind, emitting = bodies.body, bodies.p_ind, arena.emitting
-    n = arena.axy.shape[0]
+    body, p_ind = bodies.body, bodies.p_ind
     t1x, t1y = body[B_T1X, :nb], body[B_T1Y, :nb]
     for j in range(nb):
         t1x[j] = c[ZERO]
         t1y[j] = c[ZERO]
-    s_max = 0.0
     if fill:
         for e in range(n):
             for j in range(nb):
                 t1x[j] += p_ind[e, 0, j]
                 t1y[j] += p_ind[e, 1, j]
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def drop_culled_bodies(body, n, nb, arena, s_max, c, image_sum, pellet_m2, diagonal):
+    """Drop the pellets that every agent culls with all their wall images (shared mode), before their moments are
+    induced; returns the new padded body count and the bound sums of what was dropped, Mormyromast and Ampullary.
+
+    Every wall image of a point in the arena is at least as far from every
+    point in it as the point itself (images of x sit at -x + 2mW and x + 2mW)
+    and weighs at most 1. So the EOD of emitter e (monopoles +-h about its
+    centre, at distance D) polarises pellet j by at most
+    |alpha_j| x ``image_sum`` x 4 k q h / (D - h)^3, ``image_sum`` being the sum
+    of the image weights' magnitudes, identity included; summed over the
+    emitters this bounds |T1_j|. A pellet's bound at the nearest agent
+    (2 |m| / (D - r)^3, T1 times the largest agent weight ``s_max``) bounds it
+    at every agent, and its images' bounds sum to at most ``image_sum`` times
+    it. A pellet below both thresholds is dropped, so neither its induction nor
+    any later per-source pass touches it or its images. Rows B_X, B_Y, B_ALPHA,
+    B_M2X, B_M2Y are compacted (agents stay first) and padded as in
+    :func:`fill_bodies`. Every pellet carries the Ampullary moment ``pellet_m2``
+    (0 when Ampullary organs are off): when its bound across the arena's
+    ``diagonal`` reaches the threshold, no pellet can be dropped and the pass is skipped.
+    """
+    thr1, thr2, r, h = c[TOL_MORM], c[TOL_AMP], c[R_SENS], c[HALF_SEP]
+    far_gap = max(diagonal - r, 1e-100)
+    if pellet_m2 * 2.0 / (far_gap * far_gap * far_gap) >= thr2:
+        return nb, 0.0, 0.0
+    axy, emitting = arena.axy, arena.emitting
+    polarise = s_max * image_sum * 4.0 * c[K] * c[Q] * h  # per |alpha| and per 1 / (D - h)^3 of each emitter
+    skipped1 = skipped2 = 0.0
+    kept = n
+    for j in range(n, nb):
+        x, y = body[B_X, j], body[B_Y, j]
+        d2 = np.inf
+        field = 0.0
         for a in range(n):
-            s_max = max(s_max, abs(mormyromast_weights(a, emitting, c)[1]))
+            da2 = (x - axy[a, 0]) ** 2 + (y - axy[a, 1]) ** 2
+            d2 = min(d2, da2)
+            if emitting[a] and polarise > 0:
+                gap_e = max(np.sqrt(da2) - h, 1e-100)
+                field += 1.0 / (gap_e * gap_e * gap_e)
+        gap = max(np.sqrt(d2) - r, 1e-100)
+        unit = 2.0 / (gap * gap * gap)
+        b1 = polarise * abs(np.float64(body[B_ALPHA, j])) * field * unit
+        b2 = np.sqrt(np.float64(body[B_M2X, j]) ** 2 + np.float64(body[B_M2Y, j]) ** 2) * unit
+        if b1 < thr1 and b2 < thr2:
+            skipped1 += b1
+            skipped2 += b2
+        else:
+            for row in (B_X, B_Y, B_ALPHA, B_M2X, B_M2Y):
+                body[row, kept] = body[row, j]
+            kept += 1
+    padded = -(-kept // BLOCK) * BLOCK
+    for j in range(kept, padded):
+        body[B_X, j], body[B_Y, j] = 100.0, 100.0
+        body[B_ALPHA:, j] = c[ZERO]
+    return padded, skipped1 * image_sum, skipped2 * image_sum
+
+
+@njit(cache=True, error_model="numpy")
+def largest_cons_weight(emitting, c):
+    """The largest magnitude of any agent's cons weight (see :func:`mormyromast_weights`); equals the self weight
+    in shared mode, where g_self = g_cons."""
+    s_max = 0.0
+    for a in range(emitting.shape[0]):
+        s_max = max(s_max, abs(mormyromast_weights(a, emitting, c)[1]))
     return s_max
 
 
@@ -377,7 +440,8 @@ def sense_arenas(batch, plan, ws, out):
     """Add the raw readings of every arena of ``batch`` to ``out``, with the scratch arrays ``ws``.
 
     Per arena: bodies, induced moments and T1, the source list (in shared mode,
-    g_self = g_cons, without the far pellet images every agent reads densely),
+    g_self = g_cons, without the pellets every agent culls and the far pellet
+    images every agent reads densely),
     then per agent its Mormyromast moments of the listed sources (``stage.geo``
     rows G_P1X, G_P1Y, G_A1) and its readings. Fields are read once, before the loops.
     """
@@ -392,6 +456,10 @@ def sense_arenas(batch, plan, ws, out):
                                                        plan.cos_k, plan.sin_k)
     share = plan.levels.shape[0] > 0 and flags[CULL] and c[G_SELF] == c[G_CONS]
     sense = flags[DO_MORM] or flags[DO_AMP]
+    pellet_m2 = abs(c[K] * c[P_PELLET]) if flags[DO_AMP] else 0.0
+    image_sum = 0.0
+    for i in range(img_w.shape[0]):
+        image_sum += abs(img_w[i])
     for b in range(agent_xy.shape[0]):
         axy, emitting = agent_xy[b], emits[b]
         img = image_table(batch.width[b], batch.height[b], img_idx, img_w, c)
@@ -404,15 +472,22 @@ def sense_arenas(batch, plan, ws, out):
         induction = False
         for e in range(n if flags[DO_INDUCTION] else 0):
             induction = induction or emitting[e]
+        fill_t1 = share and flags[DO_MORM] and induction
+        s_max = largest_cons_weight(emitting, c) if fill_t1 else 0.0
+        dropped1 = dropped2 = 0.0
+        if share and sense:  # pellets every agent culls leave before their moments are induced
+            nb, dropped1, dropped2 = drop_culled_bodies(body, n, nb, arena, s_max, c, image_sum, pellet_m2,
+                                                        np.sqrt(batch.width[b] ** 2 + batch.height[b] ** 2))
         if induction:  # every emitter's EOD and its images polarise every body
             induced_dipoles(axy, heading[b], emitting, body[B_X, :nb], body[B_Y, :nb], body[B_ALPHA, :nb], img, c,
                             p_ind)
-        s_max = t1_moments(arena, nb, share and flags[DO_MORM] and induction, c, bodies)
+        t1_moments(nb, fill_t1, c, bodies, n)
         list_images(body[B_X, :nb], body[B_Y, :nb], body[B_M2X, :nb], body[B_M2Y, :nb], img, n, lst, own, owner)
         srcs = SourceList(lst, own, owner, nb * img.shape[0], 0, False, 0.0, 0.0, 0.0, 0.0)  # all sources, per agent
         if share and sense:  # or only those that are not shared
             image_rows(img, body[B_T1X, :nb], body[B_T1Y, :nb], lst[L_T1X], lst[L_T1Y], lst[L_A1])
-            srcs = share_far_sources(srcs.n, axy, s_max, c, level_lcq, level_e, lists, stage, flags[ERROR_BOUND])
+            srcs = share_far_sources(srcs.n, axy, s_max, c, level_lcq, level_e, lists, stage, flags[ERROR_BOUND],
+                                     dropped1, dropped2)
         weighs, srcs_lst, srcs_owner = flags[DO_MORM] and induction, srcs.lst, srcs.owner
         m1x, m1y = body[B_M1X, :nb], body[B_M1Y, :nb]
         for a in range(n if sense else 0):

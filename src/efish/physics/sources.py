@@ -261,20 +261,34 @@ def copy_columns(src, rows, index, count, dst, first):
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
-def share_far_sources(n, axy, s_max, c, level_lcq, level_e, lists, stage, want_error):
-    """Split the first ``n`` sources of ``lists.lst`` into those every agent serves by the first far level and the rest.
+def culled_everywhere(ls, owner, out):
+    """out[k] = 1 where source k is culled in both columns at every agent (bound / threshold ``ls`` below 1 at the
+    nearest agent with the largest weight), else 0; agents' bodies are never (each agent drops its own)."""
+    for k in range(ls.shape[0]):
+        out[k] = (ls[k] < 1.0) & (owner[k] == NOBODY)
+
+
+@njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
+def share_far_sources(n, axy, s_max, c, level_lcq, level_e, lists, stage, want_error, dropped1, dropped2):
+    """Split the first ``n`` sources of ``lists.lst`` into those every agent serves by the first far level, those
+    every agent culls and the rest.
 
     ``axy``: DT[N, 2], the arena's agents; ``level_lcq``, ``level_e``: float64[L]
     (see :func:`dense_level_sources`); ``lists``, ``stage``: see
     :mod:`efish.physics.kernel_inputs`. The test runs once per arena at the
     distance of the nearest agent, with the Mormyromast moment T1 times the largest
     agent weight ``s_max``, so a shared source passes the per-agent test of every
-    agent. Agents' bodies are never shared (each agent drops its own). Shared
+    agent, and a source culled there (both columns below their thresholds) is
+    culled at every agent: it is dropped here, once per arena, so that a looser
+    tolerance saves the work of distant sources in large arenas too. Agents'
+    bodies are never shared (each agent drops its own). Shared
     sources go to ``lists.shared`` (rows ``S_*``), the rest to ``lists.rest`` (rows
     ``L_*``, with ``lists.rest_own`` and ``lists.rest_owner``). Returns the rest as
     the :class:`~efish.physics.kernel_inputs.SourceList` each agent stages, with the
-    bound sums of the shared sources in both columns (for each agent's exact-zero test) and, when
-    ``want_error``, their interpolation error bounds (else 0).
+    bound sums of the shared and the dropped sources in both columns (for each agent's exact-zero test)
+    and, when ``want_error``, the shared sources' interpolation error bounds plus the dropped ones' bounds (else 0).
+    ``dropped1``, ``dropped2``: the bound sums of pellets dropped earlier, whose images are not listed
+    (:func:`efish.physics.sense_kernel.drop_culled_bodies`), added to both.
     """
     lst, geo, flag, order = lists.lst, stage.geo, stage.in_dense, stage.order
     own, owner = lists.own[:n], lists.owner[:n]
@@ -282,12 +296,13 @@ def share_far_sources(n, axy, s_max, c, level_lcq, level_e, lists, stage, want_e
     nearest_distance2(axy, lst[L_X, :n], lst[L_Y, :n], d2)
     inv1 = s_max / c[TOL_MORM]
     source_bounds(-2, d2, own, lst[L_A1, :n], lst[L_A2, :n], inv1, 1.0 / c[TOL_AMP], c[R_SENS], geo)
+    unit, a1, a2, culled = geo[G_UNIT, :n], lst[L_A1, :n], lst[L_A2, :n], geo[G_KEEP, :n]
+    culled_everywhere(geo[G_LS, :n], owner, culled)  # before G_LS turns into its log2
     dense_level_sources(n, geo, level_lcq, level_e, c, flag)
     n_shared = 0
     total1 = total2 = 0.0
-    unit, a1, a2 = geo[G_UNIT, :n], lst[L_A1, :n], lst[L_A2, :n]
     for k in range(n):  # branch-free compaction: shared first in ``order``
-        take = flag[k] & (owner[k] == NOBODY)
+        take = flag[k] & (owner[k] == NOBODY) & (culled[k] == 0)
         order[n_shared] = k
         n_shared += take
         total1 += a1[k] * unit[k] * take
@@ -296,11 +311,22 @@ def share_far_sources(n, axy, s_max, c, level_lcq, level_e, lists, stage, want_e
     rest_index = order[n_shared:n]
     for k in range(n):
         rest_index[n_rest] = k
-        n_rest += (flag[k] == 0) | (owner[k] != NOBODY)
+        n_rest += ((flag[k] == 0) | (owner[k] != NOBODY)) & (culled[k] == 0)
+    # what the culled sources may add at any agent: their bounds at the nearest one, plus those of the
+    # pellets dropped before their images were listed (``dropped1``, ``dropped2``)
+    skipped1, skipped2 = dropped1, dropped2
+    for k in range(n):
+        skipped1 += a1[k] * unit[k] * culled[k]
+        skipped2 += a2[k] * unit[k] * culled[k]
+    total1 += skipped1
+    total2 += skipped2
     err1 = err2 = 0.0
     if want_error:  # their interpolation error at the nearest agent bounds it at every agent (farther, weight <= s_max)
-        err1, err2 = level_error(flag[:n] & (owner == NOBODY), d2, unit, a1, a2, a1, a2, 2.0 ** level_lcq[0],
-                                 int(level_e[0]), c[R_SENS])
+        for k in range(n):
+            culled[k] = flag[k] & (owner[k] == NOBODY) & (culled[k] == 0)  # now: the shared ones
+        err1, err2 = level_error(culled, d2, unit, a1, a2, a1, a2, 2.0 ** level_lcq[0], int(level_e[0]), c[R_SENS])
+        err1 += skipped1
+        err2 += skipped2
     copy_columns(lst, (L_X, L_Y, L_T1X, L_T1Y, L_M2X, L_M2Y), order, n_shared, lists.shared, 0)
     copy_columns(lst, (L_X, L_Y, L_T1X, L_T1Y, L_M2X, L_M2Y, L_A1, L_A2), rest_index, n_rest, lists.rest, 0)
     rest_own, rest_owner = lists.rest_own, lists.rest_owner
