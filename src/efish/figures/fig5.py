@@ -17,7 +17,6 @@ from collections.abc import Callable
 import numpy as np
 import pandas as pd
 
-from ..analysis.onepatch import SOCIAL
 from ..config import EfishConfig
 from .panel import Panel
 from .style import (
@@ -221,6 +220,9 @@ def food_by_role(role: str) -> Callable[[Tables, object], None]:
     """Panels E (B) and F (A): food eaten per episode by ``role`` in each size class and alone."""
 
     def draw(tables: Tables, ax) -> None:
+        # imported here: the workflow imports every figure module to list the panels, and this one pulls in scipy
+        from ..analysis.onepatch import SOCIAL
+
         food = _usable(ax, tables["food"], "food_eaten", "onepatch food_per_agent")
         if food is None:
             return

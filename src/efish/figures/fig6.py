@@ -18,7 +18,6 @@ import re
 import numpy as np
 import pandas as pd
 
-from ..analysis.dynamics_tests import smaller_larger
 from ..config.schema import AnalysisConfig
 from .panel import Panel, Tables
 from .style import (
@@ -251,6 +250,9 @@ def power_near_far(tables: Tables, ax) -> None:
 def power_by_size(tables: Tables, ax) -> None:
     """Panel J: wideband power of the smallest agent of each episode vs the others (equal sizes dropped), with the
     Mann-Whitney stars of power_tests."""
+    # imported here: the workflow imports every figure module to list the panels, and this one pulls in sklearn
+    from ..analysis.dynamics_tests import smaller_larger
+
     frame, label = _power_scaled(smaller_larger(tables["dims"], tables["episodes"]))
     order = ["smaller", "larger"]
     if box_strip(ax, frame, "role", "wideband_power", order, dict(zip(order, size_class_colours(2), strict=True))):
