@@ -59,6 +59,9 @@ def test_measured_error_never_exceeds_the_reported_bound(seed, overrides):
         assert np.all(err <= bound[..., i] + slack), (name, float((err / bound[..., i]).max()))
         norm_err = np.abs(got[name] - ref[name]).max(axis=-1)
         assert np.all(norm_err <= norm_bound[..., i] + 1e-12), name
+        if overrides == ("physics.tolerance=1e-2",):  # valid but useless if a term is counted in the wrong units:
+            # a dropped pellet's bound scaled by the agent weight (~1e12) twice gave 1e11 here; measured <= 6
+            assert norm_bound[..., i].max() < 100, name
         if not overrides:  # the target for the default config; cons-only (k_cons = 100 for
             # every agent) reaches 1.2e-6 on seed 0: per-source culling lets thousands of small errors add up
             assert norm_err.max() <= 1e-6, name

@@ -287,8 +287,8 @@ def share_far_sources(n, axy, s_max, c, level_lcq, level_e, lists, stage, want_e
     the :class:`~efish.physics.kernel_inputs.SourceList` each agent stages, with the
     bound sums of the shared and the dropped sources in both columns (for each agent's exact-zero test)
     and, when ``want_error``, the shared sources' interpolation error bounds plus the dropped ones' bounds (else 0).
-    ``dropped1``, ``dropped2``: the bound sums of pellets dropped earlier, whose images are not listed
-    (:func:`efish.physics.sense_kernel.drop_culled_bodies`), added to both.
+    ``dropped1``, ``dropped2``: the bound sums (V/m, agent weight included) of pellets dropped earlier, whose
+    images are not listed (:func:`efish.physics.sense_kernel.drop_culled_bodies`), added to both.
     """
     lst, geo, flag, order = lists.lst, stage.geo, stage.in_dense, stage.order
     own, owner = lists.own[:n], lists.owner[:n]
@@ -312,9 +312,9 @@ def share_far_sources(n, axy, s_max, c, level_lcq, level_e, lists, stage, want_e
     for k in range(n):
         rest_index[n_rest] = k
         n_rest += ((flag[k] == 0) | (owner[k] != NOBODY)) & (culled[k] == 0)
-    # what the culled sources may add at any agent: their bounds at the nearest one, plus those of the
-    # pellets dropped before their images were listed (``dropped1``, ``dropped2``)
-    skipped1, skipped2 = dropped1, dropped2
+    # what the culled sources may add at any agent: their bounds at the nearest one (column 1 per unit of
+    # agent weight, like total1); the pellets dropped before their images were listed are added at the return
+    skipped1 = skipped2 = 0.0
     for k in range(n):
         skipped1 += a1[k] * unit[k] * culled[k]
         skipped2 += a2[k] * unit[k] * culled[k]
@@ -332,8 +332,10 @@ def share_far_sources(n, axy, s_max, c, level_lcq, level_e, lists, stage, want_e
     rest_own, rest_owner = lists.rest_own, lists.rest_owner
     for t in range(n_rest):
         rest_own[t], rest_owner[t] = own[rest_index[t]], owner[rest_index[t]]
-    return SourceList(lists.rest, rest_own, rest_owner, n_rest, n_shared, True, total1 * s_max, total2,
-                      err1 * s_max, err2)
+    error1 = err1 * s_max + dropped1 if want_error else 0.0  # dropped1 already carries the agent weight
+    error2 = err2 + dropped2 if want_error else 0.0
+    return SourceList(lists.rest, rest_own, rest_owner, n_rest, n_shared, True, total1 * s_max + dropped1,
+                      total2 + dropped2, error1, error2)
 
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
