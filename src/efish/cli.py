@@ -18,6 +18,7 @@
     efish bench physics [overrides] [--json]  sensing throughput, fast vs reference
     efish bench accuracy [overrides] --out D  accuracy-vs-time study -> table + figure
     efish bench scaling [overrides] --out D   cost per agent-step vs pellets and agents -> table + figure
+    efish bench multipole [overrides] [--orders P ..] [--width CM]   would cell multipoles make the far field cheaper?
     efish bench env [overrides] [--json]      env-only throughput, fast vs reference physics
     efish bench train [overrides] [--json]    rollout/update speed, model-FLOP utilisation
     efish bench budget [overrides] --minutes M fixed training time: wider net, more steps or more seeds?
@@ -155,6 +156,11 @@ def _parser() -> argparse.ArgumentParser:
     bs.add_argument("overrides", nargs="*")
     bs.add_argument("--out", type=Path, default=Path("results/bench"), help="output folder (default results/bench)")
     bs.add_argument("--json", action="store_true", help="print the table as JSON records")
+    bm = bsub.add_parser("multipole", help="cell multipoles against direct far-field reads at the plan's accuracy")
+    bm.add_argument("overrides", nargs="*")
+    bm.add_argument("--orders", type=int, nargs="+", default=[4, 6, 8], help="expansion orders (default 4 6 8)")
+    bm.add_argument("--width", type=float, default=560.0, help="square arena side of the scene, cm (default 560)")
+    bm.add_argument("--json", action="store_true", help="print the table as JSON records")
     return p
 
 
@@ -537,6 +543,11 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(json.dumps(rows, indent=2) if args.json else format_env(rows))
         elif args.bench == "scaling":
             _bench_scaling(args, cfg, started)
+        elif args.bench == "multipole":
+            from .bench.multipole import bench_multipole, format_multipole
+
+            table = bench_multipole(cfg, tuple(args.orders), args.width)
+            print(table.to_json(orient="records", indent=1) if args.json else format_multipole(table))
         elif args.bench == "pipeline":
             from .bench.pipeline import format_timings, pipeline_timings
 
