@@ -93,6 +93,8 @@ def test_quadtree_covers_every_source_once_and_its_limits_are_the_known_cases():
     assert quadtree_cost(xy, moment, agent, 0.0, 4, 0.01, box) == (0, 0, 3000)  # no cell is ever good enough
     far = np.array([50.0, 50.0])  # far outside: the whole box is one cell at a loose threshold
     assert quadtree_cost(xy, moment, far, 1.0, 4, 0.01, box) == (1, 3000, 0)
+    on_the_agent = np.repeat(agent[None], 40, axis=0)  # coinciding sources at the agent end as direct ones
+    assert quadtree_cost(on_the_agent, np.ones(40), agent, 1e-6, 4, 0.01, box) == (0, 0, 40)
 
 
 def test_bench_reports_costs_per_order_and_agent():

@@ -43,6 +43,7 @@ from .timing import best_time
 
 CELLS_TIMED = 1024   # cells (or sources) per timed call: long enough loops for SIMD, small enough for the cache
 LEAF_SOURCES = 16    # a quadtree cell with at most this many sources is read source by source
+MIN_SIDE = 1e-9      # m: a smaller cell is not split again (sources on one spot would split it forever)
 
 
 def multi_indices(order: int) -> list[tuple[int, int]]:
@@ -136,8 +137,9 @@ def quadtree_cost(xy: np.ndarray, moment: np.ndarray, agent: np.ndarray, thresho
 
     Starting from the square ``box`` (x0, y0, side), a cell whose truncation bound
     at the agent's sensor circle stays at or below ``threshold`` is evaluated as
-    one expansion; a cell of at most ``LEAF_SOURCES`` sources is read source by
-    source; any other cell is split in four.
+    one expansion; a cell of at most ``LEAF_SOURCES`` sources, or too small to
+    split further (coinciding sources), is read source by source; any other
+    cell is split in four.
     """
     cells = in_cells = direct = 0
     stack = [(box, np.arange(len(xy)))]
@@ -145,7 +147,7 @@ def quadtree_cost(xy: np.ndarray, moment: np.ndarray, agent: np.ndarray, thresho
         (x0, y0, side), members = stack.pop()
         if len(members) == 0:
             continue
-        if len(members) <= LEAF_SOURCES:
+        if len(members) <= LEAF_SOURCES or side < MIN_SIDE:
             direct += len(members)
             continue
         radius = side / np.sqrt(2.0)
