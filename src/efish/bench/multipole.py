@@ -37,7 +37,9 @@ from .._jit import njit
 from ..config.schema import EfishConfig
 from ..physics import kernels as kn
 from ..physics.fast import prepared_inputs
+from ..physics.kernel_inputs import PlanTables
 from ..physics.plan import CM
+from ..physics.sources import L_A2, L_X, L_Y, N_LIST, list_images
 from .scaling import ScalingCase, case_config, stepper
 from .timing import best_time
 
@@ -164,35 +166,34 @@ def quadtree_cost(xy: np.ndarray, moment: np.ndarray, agent: np.ndarray, thresho
     return cells, in_cells, direct
 
 
-def _direct_ns(points: int, rng: np.random.Generator, repeats: int) -> float:
-    """ns per source and point of the fast path's far-field kernel over ``CELLS_TIMED`` sources."""
-    c32 = np.zeros(kn.N_CONSTS, np.float32)
-    c32[kn.ONE], c32[kn.THREE], c32[kn.SOFT2] = 1.0, 3.0, 1e-10
+def _direct_ns(c32: np.ndarray, points: int, rng: np.random.Generator, repeats: int) -> float:
+    """ns per source and point of the fast path's far-field kernel over ``CELLS_TIMED`` sources (constants ``c32``)."""
     src = np.zeros((kn.N_SRC, CELLS_TIMED), np.float32)
     src[[kn.SX, kn.SY]] = rng.uniform(0.5, 3.0, (2, CELLS_TIMED))
     src[[kn.M1X, kn.M1Y, kn.M2X, kn.M2Y]] = rng.normal(size=(4, CELLS_TIMED))
     angles = np.linspace(0, 2 * np.pi, points, endpoint=False)
-    qx, qy = (0.01 * np.cos(angles)).astype(np.float32), (0.01 * np.sin(angles)).astype(np.float32)
+    nx, ny = np.cos(angles).astype(np.float32), np.sin(angles).astype(np.float32)
+    qx, qy = c32[kn.R_SENS] * nx, c32[kn.R_SENS] * ny
     out1, out2 = np.zeros(points, np.float32), np.zeros(points, np.float32)
-    seconds = best_time(lambda: kn.far_readings(src, 0, CELLS_TIMED, qx, qy, qx * 100, qy * 100, c32, out1, out2),
-                        repeats)
+    seconds = best_time(lambda: kn.far_readings(src, 0, CELLS_TIMED, qx, qy, nx, ny, c32, out1, out2), repeats)
     return seconds / (CELLS_TIMED * points) * 1e9
 
 
-def _cell_ns(order: int, rng: np.random.Generator, repeats: int) -> float:
+def _cell_ns(soft2: np.float32, order: int, rng: np.random.Generator, repeats: int) -> float:
     """ns per cell and point of :func:`multipole_readings` of ``order`` over ``CELLS_TIMED`` cells, float32."""
     x, y = rng.uniform(0.5, 3.0, (2, CELLS_TIMED)).astype(np.float32)
     moments = rng.normal(size=(len(multi_indices(order)), 2, 2, CELLS_TIMED)).astype(np.float32)
     deriv = np.zeros((order + 3, order + 3, CELLS_TIMED), np.float32)
     out = np.zeros((2, CELLS_TIMED), np.float32)
-    seconds = best_time(lambda: multipole_readings(x, y, np.float32(1e-10), moments, np.float32(0.6),
+    seconds = best_time(lambda: multipole_readings(x, y, soft2, moments, np.float32(0.6),
                                                    np.float32(0.8), order, deriv, out), repeats)
     return seconds / CELLS_TIMED * 1e9
 
 
-def _scene_sources(cfg: EfishConfig, width_cm: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple, float, float]:
-    """Every pellet image of one arena of a scaling scene after a few random steps: positions (m), |moment|
-    (Ampullary, k and wall weight folded in), the agents (m), a box holding every image, the threshold and r."""
+def _scene_sources(cfg: EfishConfig, width_cm: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple, PlanTables]:
+    """Every pellet image of one arena of a scaling scene after a few random steps, as the fast path lists them
+    (:func:`efish.physics.sources.list_images`): positions (m) and Ampullary |moment| (k and wall weight folded
+    in); the agents (m), a box holding every image, and the plan's kernel tables."""
     case = ScalingCase("pellets", f"{width_cm:g}x{width_cm:g}", width_cm, cfg.bench.scaling_n_agents,
                        cfg.arena.food_multiplier)
     run, _, env = stepper(case_config(cfg, case), 1, 4 * case.n_agents, cfg.bench.seed)
@@ -201,12 +202,17 @@ def _scene_sources(cfg: EfishConfig, width_cm: float) -> tuple[np.ndarray, np.nd
     tables = prepared_inputs(env.plan)
     c, side = tables.c, width_cm * CM
     pellets = batch.pellet_xy[0][batch.pellet_alive[0]] * CM
+    phi = batch.pellet_orientation[0][batch.pellet_alive[0]]
+    m2 = c[kn.K] * c[kn.P_PELLET]
     img = kn.image_table(side, side, tables.img_idx, tables.img_w, c)
-    xy = np.concatenate([np.c_[row[0] + row[1] * pellets[:, 0], row[2] + row[3] * pellets[:, 1]] for row in img])
-    moment = np.concatenate([np.full(len(pellets), abs(c[kn.K] * c[kn.P_PELLET] * row[4])) for row in img])
+    count = len(pellets) * img.shape[0]
+    lst, own, owner = np.empty((N_LIST, count)), np.empty(count, np.int64), np.empty(count, np.int64)
+    list_images(pellets[:, 0].copy(), pellets[:, 1].copy(), -m2 * np.sin(phi), m2 * np.cos(phi), img, 0, lst, own,
+                owner)
+    xy = np.ascontiguousarray(lst[[L_X, L_Y]].T)
     lo, hi = xy.min(axis=0), xy.max(axis=0)
     box = (float(lo[0]), float(lo[1]), float((hi - lo).max()) * (1 + 1e-9))
-    return xy, moment, batch.agent_xy[0] * CM, box, float(c[kn.TOL_AMP]), float(c[kn.R_SENS])
+    return xy, lst[L_A2].copy(), batch.agent_xy[0] * CM, box, tables
 
 
 def bench_multipole(cfg: EfishConfig, orders: tuple[int, ...] = (4, 6, 8), width_cm: float = 560.0,
@@ -223,11 +229,12 @@ def bench_multipole(cfg: EfishConfig, orders: tuple[int, ...] = (4, 6, 8), width
         raise ValueError(f"width_cm must be positive, got {width_cm}")
     rng = np.random.default_rng(cfg.bench.seed)
     points = int(cfg.physics.far_field_levels[0]) if cfg.physics.far_field_levels else 1
-    direct_ns = _direct_ns(points, rng, repeats)
-    xy, moment, agents, box, threshold, r = _scene_sources(cfg, width_cm)
+    xy, moment, agents, box, tables = _scene_sources(cfg, width_cm)
+    threshold, r = float(tables.c[kn.TOL_AMP]), float(tables.c[kn.R_SENS])
+    direct_ns = _direct_ns(tables.c32, points, rng, repeats)
     rows = []
     for order in orders:
-        cell_ns = _cell_ns(order, rng, repeats)
+        cell_ns = _cell_ns(tables.c32[kn.SOFT2], order, rng, repeats)
         for a, agent in enumerate(agents):
             cells, _, direct = quadtree_cost(xy, moment, agent, threshold, order, r, box)
             rows.append({"order": order, "agent": a, "cell_ns": cell_ns, "direct_ns": direct_ns, "cells": cells,
