@@ -147,7 +147,8 @@ def _episode_steps(rng, cond: str, episode: int, n: int, steps: int, arena_cm: f
             **{f"food_{k}5cm": rng.integers(0, 3, (steps, n)) for k in ("count_", "front_", "left_", "back_",
                                                                        "right_")},
             "n_knollen_agents": rng.integers(0, n, (steps, n)), "log_morm_field": rng.normal(-6, 1, (steps, n)),
-            "log_amp_field": rng.normal(-10, 1, (steps, n)),
+            "log_amp_field": rng.normal(-10, 1, (steps, n)), "n_agents_100cm": (d < 100).sum(-1),
+            "log_morm_sensed": np.where(rng.random((steps, n)) < 0.5, rng.uniform(-7.3, -1.3, (steps, n)), np.nan),
             **{f"err_{c}_rad": np.full((steps, n), np.nan) for c in ("morm", "amp", "knollen")}}
     t, agent = np.repeat(np.arange(steps), n), np.tile(np.arange(n), steps)
     return pd.DataFrame({"condition": cond, "episode": episode, "t": t, "t_ms": t * 1000.0 / 83.0, "agent": agent,

@@ -1,10 +1,15 @@
-"""The ``efish`` command's own logic: the training log line."""
+"""The ``efish`` command's own logic: the training log line; ``efish claims`` with the other top seeds' claims tables
+(seed_verdicts, seeds_agree) and ``efish compare-claims`` showing seeds_agree."""
 
 from __future__ import annotations
 
 import math
 
-from efish.cli import ReturnLog
+import pandas as pd
+import pytest
+
+from efish.analysis.claim_parts import ROW_COLUMNS
+from efish.cli import ReturnLog, main
 
 
 def test_the_training_log_never_prints_nan():
@@ -13,3 +18,92 @@ def test_the_training_log_never_prints_nan():
     assert log.line({"episode_return": 12.5, "episodes_ended": 3}) == "return 12.500 (3 episodes)"
     assert log.line({"episode_return": math.nan, "episodes_ended": 0}) == "no episode ended since the last line"
     assert "nan" not in log.line({"episode_return": -1.0, "episodes_ended": 1})
+
+
+# ------------------------------------------------- efish claims across seeds (CLAIMS.md rule 4)
+def claims_rows(verdicts: dict[str, str]) -> pd.DataFrame:
+    """A claims table (ROW_COLUMNS) with the given verdict per claim."""
+    n = len(verdicts)
+    return pd.DataFrame({"claim": list(verdicts), "panel": ["3O"] * n, "statistic": ["Spearman rho"] * n,
+                         "effect": [0.4] * n, "ci_low": [0.1] * n, "ci_high": [0.7] * n, "n": [8] * n,
+                         "p": [0.01] * n, "verdict": list(verdicts.values()), "reason": [""] * n}, columns=ROW_COLUMNS)
+
+
+@pytest.fixture
+def seed_run(tmp_path, monkeypatch):
+    """A run folder with a ranking (seed 3 selected, then 1 and 7) and the claims tables of seeds 1 and 7; the
+    selected seed's claims are a fixed table (claims_table is replaced: these tests are about the CLI)."""
+    from efish.analysis import claims
+
+    monkeypatch.setattr(claims, "claims_table", lambda results, cfg: claims_rows({"C1": "holds", "C9": "holds"}))
+    run = tmp_path / "results" / "myrun"
+    (run / "analysis" / "selection").mkdir(parents=True)
+    pd.DataFrame({"seed": [3, 1, 7, 2]}).to_parquet(run / "analysis" / "selection" / "ranking.parquet")
+    for seed, verdicts in ((1, {"C1": "not run", "C9": "weaker"}), (7, {"C1": "not run", "C9": "holds"})):
+        (run / "seeds" / f"seed_{seed}" / "claims").mkdir(parents=True)
+        claims_rows(verdicts).to_parquet(run / "seeds" / f"seed_{seed}" / "claims" / "claims.parquet")
+    return run
+
+
+def seed_table(run, seed: int) -> str:
+    return f"{seed}={run / 'seeds' / f'seed_{seed}' / 'claims' / 'claims.parquet'}"
+
+
+def test_efish_claims_adds_the_verdicts_of_the_other_top_seeds(seed_run, capsys):
+    out = seed_run / "claims"
+    assert main(["claims", "scale=smoke", "--results", str(seed_run), "--out", str(out),
+                 "--ranking", str(seed_run / "analysis/selection/ranking.parquet"),
+                 "--seed-claims", seed_table(seed_run, 7), seed_table(seed_run, 1)]) == 0
+    table = pd.read_parquet(out / "claims.parquet").set_index("claim")
+    assert list(table.reset_index().columns) == [*ROW_COLUMNS[:9], "seed_verdicts", "seeds_agree", "reason"]
+    assert table.loc["C9", "seed_verdicts"] == "seed 3: holds; seed 1: weaker; seed 7: holds"  # ranking order
+    assert table.loc["C9", "seeds_agree"] == "2/3 hold, 1/3 weaker"
+    assert "flips between seeds" in table.loc["C9", "reason"]
+    assert table.loc["C1", "seeds_agree"] == "1/1 hold (other seeds: not run)"
+    page = (out / "claims.md").read_text()
+    assert "| verdict | seeds_agree | reason |" in page and "| holds | 2/3 hold, 1/3 weaker |" in page
+    assert "selected seed 3, other top seeds 1, 7" in page.splitlines()[0]
+    assert "seeds_agree" in capsys.readouterr().out
+
+
+def test_efish_claims_reads_the_runs_ranking_by_default_and_alone_gives_the_selected_seed(seed_run):
+    assert main(["claims", "scale=smoke", "--results", str(seed_run), "--seed-claims", seed_table(seed_run, 1)]) == 0
+    table = pd.read_parquet(seed_run / "claims" / "claims.parquet").set_index("claim")
+    assert table.loc["C9", "seed_verdicts"] == "seed 3: holds; seed 1: weaker"
+    assert main(["claims", "scale=smoke", "--results", str(seed_run), "--seed-claims"]) == 0  # no other seed
+    assert pd.read_parquet(seed_run / "claims" / "claims.parquet")["seeds_agree"].tolist() == ["1/1 hold"] * 2
+
+
+def test_efish_claims_without_seed_tables_keeps_its_columns(seed_run):
+    assert main(["claims", "scale=smoke", "--results", str(seed_run)]) == 0
+    assert list(pd.read_parquet(seed_run / "claims" / "claims.parquet").columns) == ROW_COLUMNS
+    assert "seeds_agree" not in (seed_run / "claims" / "claims.md").read_text()
+
+
+@pytest.mark.parametrize("seed_args, message", [
+    (["9=x.parquet"], "seeds [9] are not in the ranking"),
+    (["one=x.parquet"], "write SEED=PATH"),
+    (["--ranking", "nowhere.parquet", "--seed-claims", "1=x.parquet"], "no seed ranking at nowhere.parquet"),
+    (["3=SELF"], "seed 3 is the selected seed"),
+])
+def test_efish_claims_refuses_bad_seed_tables_in_one_line_and_writes_nothing(seed_run, capsys, seed_args, message):
+    seed_args = [a.replace("SELF", str(seed_run / "seeds/seed_1/claims/claims.parquet")) for a in seed_args]
+    args = seed_args if seed_args[0].startswith("--") else ["--seed-claims", *seed_args]
+    assert main(["claims", "scale=smoke", "--results", str(seed_run), *args]) == 2
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1
+    assert not (seed_run / "claims").exists()
+
+
+def test_compare_claims_shows_each_runs_seeds_agree_and_a_dash_without(tmp_path, capsys):
+    from efish.analysis.claims_seeds import with_seed_verdicts
+
+    with_seeds = with_seed_verdicts(claims_rows({"C9": "holds"}), {1: claims_rows({"C9": "holds"})}, 3)
+    (tmp_path / "new").mkdir()
+    (tmp_path / "old").mkdir()
+    with_seeds.to_parquet(tmp_path / "new" / "claims.parquet")
+    claims_rows({"C9": "weaker"}).to_parquet(tmp_path / "old" / "claims.parquet")
+    assert main(["compare-claims", str(tmp_path / "new"), str(tmp_path / "old")]) == 0
+    header, row = capsys.readouterr().out.splitlines()
+    assert "new seeds_agree" in header and "old seeds_agree" in header
+    assert "2/2 hold" in row and " - " in row and row.rstrip().endswith("*")

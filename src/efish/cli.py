@@ -12,8 +12,10 @@
     efish render assay=NAME [overrides] [--condition C] [--episode K] [--out F.gif|F.mp4] [--field]
                                               one episode of an assay as a clip, from its rollout tables
     efish contact-sheet [overrides] [--figures D] [--out F.png]   every panel's PNG as a thumbnail with its id
-    efish claims [overrides] [--results D] [--out D]   the paper's claims as verdicts -> claims.parquet, claims.md
-    efish compare-claims A B                  two runs' claim verdicts and effects side by side
+    efish claims [overrides] [--results D] [--out D] [--ranking F] [--seed-claims SEED=F ...]
+                                              the paper's claims as verdicts -> claims.parquet, claims.md; with the
+                                              other top seeds' claims tables, seed_verdicts and seeds_agree too
+    efish compare-claims A B                  two runs' claim verdicts, seeds_agree and effects side by side
     efish scene NAME [overrides] --out D      field maps of config/scene/NAME.yaml -> D/NAME.parquet
     efish bench physics [overrides] [--json]  sensing throughput, fast vs reference
     efish bench accuracy [overrides] --out D  accuracy-vs-time study -> table + figure
@@ -109,6 +111,13 @@ def _parser() -> argparse.ArgumentParser:
     cl.add_argument("overrides", nargs="*", help="config overrides, e.g. scale=smoke analysis.claims_resamples=200")
     cl.add_argument("--results", type=Path, help="the run's results folder (default results/{run})")
     cl.add_argument("--out", type=Path, help="folder for claims.parquet and claims.md (default <results>/claims)")
+    cl.add_argument("--seed-claims", nargs="*", metavar="SEED=PATH",
+                    help="the claims.parquet of each other top seed (results/{run}/seeds/seed_<n>/claims/): adds "
+                         "seed_verdicts and seeds_agree (CLAIMS.md rule 4); given with no value, the selected seed's "
+                         "alone ('1/1 hold')")
+    cl.add_argument("--ranking", type=Path,
+                    help="the seed ranking, whose first row is the selected seed (default with --seed-claims: "
+                         "<results>/analysis/selection/ranking.parquet); alone it adds the seed columns too")
     cc = sub.add_parser("compare-claims", help="two runs' claim verdicts and effect sizes side by side")
     cc.add_argument("a", help="claims.parquet, a claims folder, or a run name (results/<name>/claims/claims.parquet)")
     cc.add_argument("b", help="the same for the second run")
@@ -324,15 +333,54 @@ def _claims(args, cfg, started) -> None:
     if not results.is_dir():
         raise ValueError(f"results folder {results} does not exist")
     out = args.out or results / "claims"
+    seeds = _seed_claims(args, results)  # read before anything is computed or written
     table = claims_table(results, cfg)
     header = (f"Claims of the paper at scale {cfg.scale.name} (run {results.name}), "
               f"{started.strftime('%Y-%m-%d %H:%M UTC')}")
+    if seeds is not None:
+        from .analysis.claims_seeds import with_seed_verdicts
+
+        selected, others = seeds
+        table = with_seed_verdicts(table, others, selected)
+        header += f"; selected seed {selected}" + (f", other top seeds {', '.join(map(str, others))}" if others else "")
     write_parquet_tables({"claims": table}, out)
     write_text_atomic(out / "claims.md", claims_markdown(table, header))
-    _metadata(out, cfg, started, args, results=str(results))
-    print(table[["claim", "panel", "effect", "ci_low", "ci_high", "n", "p", "verdict"]].to_string(
+    _metadata(out, cfg, started, args, results=str(results),
+              **({} if seeds is None else {"selected_seed": seeds[0], "other_seeds": list(seeds[1])}))
+    shown = ["claim", "panel", "effect", "ci_low", "ci_high", "n", "p", "verdict"]
+    print(table[shown + ["seeds_agree"] * ("seeds_agree" in table.columns)].to_string(
         index=False, float_format=lambda v: f"{v:.3g}"))
     print(f"wrote {out / 'claims.parquet'} and {out / 'claims.md'}")
+
+
+def _seed_claims(args, results: Path):
+    """(selected seed, {other seed: its claims table} in ranking order) from --ranking and --seed-claims, or None
+    when neither is given (the table keeps the columns of ROW_COLUMNS)."""
+    from .io import read_parquet
+
+    if args.seed_claims is None and args.ranking is None:
+        return None
+    ranking_path = args.ranking or results / "analysis" / "selection" / "ranking.parquet"
+    if not ranking_path.is_file():
+        raise ValueError(f"no seed ranking at {ranking_path}: --seed-claims needs --ranking (its first row is the "
+                         "selected seed)")
+    ranking = [int(s) for s in read_parquet(ranking_path, "the seed ranking")["seed"]]
+    if not ranking:
+        raise ValueError(f"the seed ranking {ranking_path} has no seed")
+    paths = {}
+    for item in args.seed_claims or []:
+        seed, sep, path = item.partition("=")
+        if not (sep and seed.strip().isdigit() and path):
+            raise ValueError(f"--seed-claims {item!r}: write SEED=PATH, e.g. 3=results/laptop/seeds/seed_3/claims/"
+                             "claims.parquet")
+        if int(seed) in paths:
+            raise ValueError(f"--seed-claims names seed {int(seed)} twice")
+        paths[int(seed)] = Path(path)
+    if unknown := sorted(set(paths) - set(ranking)):
+        raise ValueError(f"--seed-claims: seeds {unknown} are not in the ranking {ranking_path} "
+                         f"(seeds {', '.join(map(str, ranking))})")
+    ordered = sorted(paths, key=ranking.index)
+    return ranking[0], {s: read_parquet(paths[s], f"seed {s}'s claims table") for s in ordered}
 
 
 def _compare_claims(args) -> None:

@@ -9,8 +9,14 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from efish.analysis._tables import DEFAULTS
 from efish.analysis.dynamics import (
+    DECODE_COLUMNS,
+    DECODE_TARGETS,
+    READOUT_TARGETS,
+    SENSED_TARGETS,
     decode,
+    decode_table,
     degenerate_reason,
     dynamics_table,
     effective_dimensionality,
@@ -195,3 +201,42 @@ def test_food_decoding_splits_at_the_near_distance_and_scores_only_where_the_sta
     assert table.loc[("far", "dist_food_cm"), "n"] == np.sum(dist > 10)
     lacking = food_decode_table(hidden, steps.drop(columns="dist_food_cm"), near_cm=10.0)
     assert lacking["reason"].iloc[0] == "steps table lacks column 'dist_food_cm'"
+
+
+def test_sensed_and_readout_targets_split_the_decoded_columns():
+    """CLAIMS rule 7: the policy's own outputs and size are readouts, never sensed competitors (claim C19)."""
+    assert set(SENSED_TARGETS).isdisjoint(READOUT_TARGETS)
+    assert DECODE_TARGETS == {**SENSED_TARGETS, **READOUT_TARGETS}
+    assert set(READOUT_TARGETS) == {"turn_rad", "eod", "size"}
+    fig_6e = {"dist_agent_cm", "n_agents_100cm", "log_morm_sensed", "dist_wall_cm"}
+    assert fig_6e <= set(SENSED_TARGETS) and not SENSED_TARGETS["dist_agent_cm"]
+    # the bearings are circular; the realised turn is a small signed change, decoded as a number
+    assert all(DECODE_TARGETS[c] == c.startswith("bearing_") for c in DECODE_TARGETS)
+
+
+def test_the_decoding_table_marks_the_readouts():
+    rng = np.random.default_rng(0)
+    x, groups = planted(rng, n_episodes=6, per=40, d=4)
+    hidden = pd.DataFrame(x, columns=[f"h_{i}" for i in range(4)]).assign(
+        condition="control", episode=groups, agent=0, t=np.tile(np.arange(40), 6))
+    steps = hidden[["condition", "episode", "agent", "t"]].assign(
+        dist_agent_cm=x[:, 0] + 10, eod=(x[:, 1] > 0).astype(float), turn_rad=x[:, 2])
+    whole = decode_table(hidden, steps)
+    assert list(whole.columns) == DECODE_COLUMNS and len(whole) == len(DECODE_TARGETS)
+    table = whole.set_index("target")
+    assert table["readout"].to_dict() == {t: t in READOUT_TARGETS for t in DECODE_TARGETS}
+    assert table.loc["dist_agent_cm", "score"] > 0.9 and table.loc["turn_rad", "score"] > 0.9
+    assert table.loc["log_morm_sensed", "reason"] == "steps table lacks column 'log_morm_sensed'"
+
+
+def test_food_is_near_within_the_configured_5_cm_by_default():
+    assert DEFAULTS.claims_food_near_cm == 5.0  # the authors' Mormyromast food range
+    rng = np.random.default_rng(0)
+    x, groups = planted(rng, n_episodes=6, per=40, d=3)
+    dist = np.tile(np.linspace(0.0, 12.0, 40), 6)
+    hidden = pd.DataFrame(x, columns=[f"h_{i}" for i in range(3)]).assign(
+        condition="control", episode=groups, agent=0, t=np.tile(np.arange(40), 6))
+    steps = hidden[["condition", "episode", "agent", "t"]].assign(dist_food_cm=dist, bearing_food_rad=x[:, 0])
+    table = food_decode_table(hidden, steps).set_index(["food", "target"])
+    assert table.loc[("near", "dist_food_cm"), "n"] == np.sum(dist <= 5.0)
+    assert table.loc[("far", "dist_food_cm"), "n"] == np.sum(dist > 5.0)

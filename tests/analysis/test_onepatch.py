@@ -1,5 +1,6 @@
 """The one-patch analysis's statistic tables: roles from the condition names, role_tests (Mann-Whitney of food
-by role) and reach_tests (Fisher exact of the bot assay's reach counts), on data with the effect built in."""
+by role and size class against the size-matched alone control) and reach_tests (Fisher exact of the bot assay's
+reach counts), on data with the effect built in."""
 
 from __future__ import annotations
 
@@ -8,23 +9,54 @@ import pandas as pd
 import pytest
 from scipy import stats as sps
 
-from efish.analysis.onepatch import bot_reach_counts, food_from_steps, reach_tests, role_tests, roles
+from efish.analysis.onepatch import (
+    ALONE,
+    ALONE_CLASS,
+    MATCHED_ALONE,
+    SOCIAL,
+    SOCIAL_SIZES,
+    bot_reach_counts,
+    food_from_steps,
+    reach_tests,
+    role_tests,
+    roles,
+)
 from efish.analysis.stats import STAT_COLUMNS, fisher_rates, fisher_row
+from efish.config import compose
 
 
-def onepatch_steps(b_social: float, b_alone: float, episodes: int = 8, steps: int = 10) -> pd.DataFrame:
-    """Steps whose ``ate`` sums to known food: B (agent 1) eats ``b_social`` + episode in each social condition,
-    ``b_alone`` + episode alone; A eats 3 + episode everywhere."""
+def onepatch_steps(b_social: float, b_alone: float, episodes: int = 8, steps: int = 10,
+                   classes=("A_gt_B", "A_lt_B")) -> pd.DataFrame:
+    """Steps whose ``ate`` sums to known food: B (agent 1) eats ``b_social`` + episode in each social condition of
+    ``classes``, ``b_alone`` + episode alone at the matched size; A eats 3 + episode everywhere."""
+    eaten = {}
+    for c in classes:
+        eaten |= {(c, 0): 3, (c, 1): b_social, (MATCHED_ALONE["A", c], 0): 3, (MATCHED_ALONE["B", c], 0): b_alone}
     rows = []
     for e in range(episodes):
-        eaten = {("A_gt_B", 0): 3, ("A_gt_B", 1): b_social, ("A_lt_B", 0): 3, ("A_lt_B", 1): b_social,
-                 ("A_alone", 0): 3, ("B_alone", 0): b_alone}
         for (cond, agent), k in eaten.items():
             ate = np.zeros(steps, int)
             ate[: int(k) + e % 3] = 1
             rows.append(pd.DataFrame({"condition": cond, "episode": e, "agent": agent, "t": np.arange(steps),
                                       "ate": ate}))
     return pd.concat(rows, ignore_index=True)
+
+
+def test_alone_controls_match_the_sizes_of_the_assay_config():
+    conditions = compose(["assay=onepatch"]).assay.conditions
+    assert set(conditions) == {*SOCIAL, *ALONE}
+    for cond, extra in conditions.items():
+        cfg = compose(["assay=onepatch", *extra])
+        if cond in ALONE:
+            role, size = ALONE[cond]
+            assert cfg.env.n_agents == 1 and cfg.env.sizes == [size], cond
+            assert cfg.env.roles == [{"A": "resident", "B": "intruder"}[role]], cond
+            assert cond == f"{role}_alone_{round(100 * size)}"
+        else:
+            assert tuple(cfg.env.sizes) == SOCIAL_SIZES[cond] and cfg.env.roles == ["resident", "intruder"]
+    for (role, social), alone in MATCHED_ALONE.items():  # the lone agent has the size its role has in the class
+        assert ALONE[alone] == (role, SOCIAL_SIZES[social]["AB".index(role)])
+    assert sorted(MATCHED_ALONE.values()) == sorted(ALONE) and len(ALONE_CLASS) == len(ALONE)
 
 
 def test_food_is_the_sum_of_ate_per_agent_episode():
@@ -34,33 +66,50 @@ def test_food_is_the_sum_of_ate_per_agent_episode():
 
 
 def test_roles_follow_the_assay_config():
-    food = pd.DataFrame({"condition": ["A_gt_B", "A_gt_B", "A_alone", "B_alone", "bot0.5_B0.5_rate0_frozen"],
-                         "agent": [0, 1, 0, 0, 1]})
+    food = pd.DataFrame({"condition": ["A_gt_B", "A_gt_B", "A_alone_75", "B_alone_25", "B_alone_75",
+                                       "bot0.5_B0.5_rate0_frozen"],
+                         "agent": [0, 1, 0, 0, 0, 1]})
     r = roles(food)
-    assert r["role"].tolist() == ["A", "B", "A", "B"]
-    assert r["setting"].tolist() == ["A_gt_B", "A_gt_B", "alone", "alone"]
+    assert r["role"].tolist() == ["A", "B", "A", "B", "B"]
+    assert r["setting"].tolist() == ["A_gt_B", "A_gt_B", "alone", "alone", "alone"]
+    # B alone at 0.75 is the control of B in A_lt_B, where B is 0.75
+    assert r["size_class"].tolist() == ["A_gt_B", "A_gt_B", "A_gt_B", "A_gt_B", "A_lt_B"]
 
 
-def test_role_tests_find_b_eating_more_with_a_and_a_unaffected():
+def test_role_tests_compare_each_role_with_its_size_matched_alone_control():
     food = food_from_steps(onepatch_steps(b_social=6, b_alone=1))
     tests = role_tests(food)
-    assert list(tests.columns[: len(STAT_COLUMNS)]) == STAT_COLUMNS
+    assert list(tests.columns) == [*STAT_COLUMNS, "role"]
+    assert len(tests) == 2 * len(SOCIAL) and tests.groupby("role")["group"].apply(set).to_dict() == {
+        "A": set(SOCIAL), "B": set(SOCIAL)}
     b = tests[tests["role"] == "B"].set_index("group")
-    assert set(b.index) == {"A_gt_B", "A_lt_B"} and (b["control"] == "alone").all()
+    assert b.loc["A_gt_B", "control"] == "B_alone_25" and b.loc["A_lt_B", "control"] == "B_alone_75"
     assert b.loc["A_gt_B", "effect"] == pytest.approx(5.0)  # medians 6+1 and 1+1
     social = food[(food["condition"] == "A_gt_B") & (food["agent"] == 1)]["food_eaten"]
-    alone = food[food["condition"] == "B_alone"]["food_eaten"]
+    alone = food[food["condition"] == "B_alone_25"]["food_eaten"]
     assert b.loc["A_gt_B", "p"] == pytest.approx(sps.mannwhitneyu(social, alone).pvalue)
     assert b.loc["A_gt_B", "p"] < 0.01 and b.loc["A_gt_B", "stars"] != "ns"
-    a = tests[tests["role"] == "A"].iloc[0]
-    assert (a["group"], a["effect"], a["n"], a["n_control"]) == ("social", 0.0, 16, 8)
+    a = tests[tests["role"] == "A"].set_index("group")
+    assert a.loc["A_gt_B", "control"] == "A_alone_75" and a.loc["A_lt_B", "control"] == "A_alone_25"
+    assert (a.loc["A_gt_B", "effect"], a.loc["A_gt_B", "n"], a.loc["A_gt_B", "n_control"]) == (0.0, 8, 8)
+
+
+def test_role_tests_never_compare_across_sizes():
+    """B alone at 0.75 eats much more than B alone at 0.25: each class's row sees only its own control."""
+    food = food_from_steps(onepatch_steps(b_social=4, b_alone=4))
+    big = food["condition"] == "B_alone_75"
+    food.loc[big, "food_eaten"] += 5
+    b = role_tests(food).query("role == 'B'").set_index("group")
+    assert b.loc["A_gt_B", "effect"] == 0.0 and b.loc["A_lt_B", "effect"] == -5.0
 
 
 def test_role_tests_say_why_there_is_no_test():
     food = food_from_steps(onepatch_steps(6, 1))
-    no_b_alone = role_tests(food[food["condition"] != "B_alone"])
-    assert np.isnan(no_b_alone.loc[no_b_alone["role"] == "B", "p"]).all()
-    assert "B_alone" in no_b_alone.loc[no_b_alone["role"] == "B", "reason"].item()
+    no_b_alone = role_tests(food[food["condition"] != "B_alone_25"]).set_index(["role", "group"])
+    assert np.isnan(no_b_alone.loc[("B", "A_gt_B"), "p"])
+    assert "B_alone_25" in no_b_alone.loc[("B", "A_gt_B"), "reason"]
+    assert np.isfinite(no_b_alone.loc[("B", "A_lt_B"), "p"])
+    assert "A_eq_B" in no_b_alone.loc[("A", "A_eq_B"), "reason"]  # this table has no A = B episode
     bot = role_tests(pd.DataFrame({"condition": ["bot0.5_B0.5_rate0_frozen"], "agent": [1], "food_eaten": [1.0]}))
     assert len(bot) == 1 and "no one-patch condition" in bot["reason"].item()
 

@@ -21,7 +21,7 @@ SPEC_ASSAYS = {"homing", "patchy4", "uniform4", "wide2", "square2", "ablation4",
 
 
 #: Statistic tables that test the conditions of one assay -> condition names of that assay to run them on.
-ASSAY_SPECIFIC = {("onepatch", "role_tests"): ("A_gt_B", "A_alone", "B_alone"),
+ASSAY_SPECIFIC = {("onepatch", "role_tests"): ("A_gt_B", "A_alone_75", "B_alone_25"),
                   ("onepatch", "reach_tests"): ("bot0.5_B0.5_rate0_frozen", "bot0.5_B0.5_rate1_moving"),
                   ("dynamics", "size_tests"): ("n2_K", "n4_K", "n2_noK", "n4_noK")}
 

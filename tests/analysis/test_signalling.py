@@ -14,6 +14,7 @@ from efish.analysis.signalling import (
     load_real_idis,
     peri_event_rate,
     rate_advantage_vs_size,
+    xmin_in_steps,
 )
 
 STEP_MS = 1000.0 / 83.0
@@ -42,6 +43,19 @@ def test_power_law_alpha_recovered_on_1e4_samples():
     fit = fit_power_law(x)
     assert abs(fit["alpha"] - 2.5) < 0.1 and fit["n"] == 10_000 and fit["xmin"] == 12.0
     assert fit["R_exponential"] > 0 and fit["p_exponential"] < 0.05  # a power law beats an exponential
+
+
+def test_discrete_power_law_of_whole_steps():
+    """IDIs are whole steps: a discrete fit from xmin = 1 step recovers a zeta law's alpha and prefers it to an
+    exponential, and rejects it for geometric (memoryless) steps; 12 ms is 1 step of 12.048 ms."""
+    from scipy import stats as sps
+
+    x = sps.zipf(2.5).rvs(20_000, random_state=1)
+    fit = fit_power_law(x, 1, discrete=True)
+    assert abs(fit["alpha"] - 2.5) < 0.1 and fit["R_exponential"] > 0 and fit["p_exponential"] < 0.05
+    geometric = fit_power_law(np.random.default_rng(2).geometric(0.3, 20_000), 1, discrete=True)
+    assert geometric["R_exponential"] < 0 and geometric["p_exponential"] < 0.05
+    assert xmin_in_steps(12.0, 12.048) == 1 and xmin_in_steps(24.1, 12.048) == 3 and xmin_in_steps(0.0) == 1
 
 
 def test_lognormal_data_prefer_lognormal():

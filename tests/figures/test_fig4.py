@@ -72,6 +72,44 @@ def test_a_condition_without_a_test_row_is_marked_n_a():
     assert texts(ax) == ["n/a"]
 
 
+def test_collective_shows_the_authors_self_only_mode_beside_the_clean_gate():
+    values = {"control": [6.0, 6.0], "self_only": [5.0, 4.0], "self_only_authors": [5.5, 5.0], "cons_only": [6.0]}
+    tests = dunnett({"self_only": "*", "self_only_authors": "**", "cons_only": "ns"}, "control")
+    ax = draw("fig4/G", {"summary": summary(values), "tests": tests})
+    labels = [t.get_text() for t in ax.get_xticklabels()]
+    assert labels == ["control", "self only\n(clean gate)", "self only\n(authors' mode)", "cons only"]
+    np.testing.assert_allclose(points_at(ax, 2), [5.0, 5.5])
+    assert sorted(texts(ax)) == ["*", "**", "ns"]
+    assert "authors' mode" in PANELS["fig4/G"].caption and "wall_distortion" in PANELS["fig4/G"].caption
+
+
+def test_mute_draws_the_results_design_first_and_the_methods_design_beside_it():
+    values = {"intact": [6.0, 7.0], "muted": [3.0, 4.0], "intact4": [20.0, 22.0], "muted4": [18.0]}
+    tests = pd.concat([dunnett({"muted": "***", "intact4": "****", "muted4": "****"}, "intact"),
+                       dunnett({"muted4": "*"}, "intact4", measure="theil_t")])  # another measure: not drawn
+    ax = draw("fig4/I", {"summary": summary(values), "tests": tests})
+    for x, cond in [(0, "intact"), (1, "muted"), (3, "intact4"), (4, "muted4")]:  # an empty slot between designs
+        np.testing.assert_allclose(points_at(ax, x), sorted(values[cond]))
+    assert [t.get_text() for t in ax.get_xticklabels()] == ["none\nmuted", "agent 1\nmuted", "",
+                                                             "none\nmuted", "agent 0\nmuted"]
+    designs = [t.get_text() for t in ax.get_xticklabels(minor=True)]
+    assert designs == ["2 agents, uniform 70x70\n(Results, decides C12)", "4 agents, patchy 70x70\n(Methods)"]
+    # stars only from a row of exactly the pair: muted4 vs intact (the Dunnett control) is not the 4-agent test
+    assert sorted(texts(ax)) == ["***", "n/a"]
+
+
+def test_mute_designs_follow_the_assay_config():
+    from efish.figures.style import assay_conditions
+
+    configs = assay_conditions("mute")
+    assert list(configs) == [c for intact, muted, _ in fig4.MUTE_DESIGNS for c in (intact, muted)]
+    (intact, muted, _), (intact4, muted4, _) = fig4.MUTE_DESIGNS
+    assert (configs[intact].env.n_agents, configs[intact].arena.layout, configs[muted].env.muted) == (2, "uniform", [1])
+    assert (configs[intact4].env.n_agents, configs[intact4].arena.layout, configs[muted4].env.muted) == (4, "patchy",
+                                                                                                       [0])
+    assert configs[intact].assay.seed == configs[intact4].assay.seed  # paired episodes within each design
+
+
 def test_a_measure_without_finite_values_says_why():
     frame = summary({"intact": [np.nan], "muted": [np.nan]}, "mean_nn_dist_cm").assign(reason="no other agent")
     ax = draw("fig4/J", {"summary": frame, "tests": dunnett({"muted": "n/a"}, "intact", "mean_nn_dist_cm")})

@@ -45,15 +45,23 @@ def test_roles_follow_the_onepatch_config():
         alone = "env.n_agents=1" in extra
         assert len(roles[cond]) == (1 if alone else 2), cond
     assert roles["A_lt_B"] == {"A": 0, "B": 1}
-    assert roles["B_alone"] == {"B": 0} and roles["A_alone"] == {"A": 0}
+    assert roles["B_alone_75"] == {"B": 0} and roles["A_alone_25"] == {"A": 0}
+
+
+def test_alone_controls_are_matched_by_size_as_the_analysis_matches_them():
+    from efish.analysis.onepatch import MATCHED_ALONE
+
+    assert fig5.matched_alone() == MATCHED_ALONE
+    assert fig5.class_slots("B", ["A_gt_B", "A_lt_B", "B_alone_25", "B_alone_75", "B_alone_50"]) == [
+        "A_lt_B", "B_alone_75", " ", "A_gt_B", "B_alone_25", "  ", "B_alone_50"]  # an unmatched control last
 
 
 def test_role_rows_picks_b_in_each_condition_and_rejects_bad_roles():
-    table = pd.DataFrame({"condition": ["A_lt_B", "A_lt_B", "B_alone", "A_alone"], "agent": [0, 1, 0, 0],
+    table = pd.DataFrame({"condition": ["A_lt_B", "A_lt_B", "B_alone_75", "A_alone_25"], "agent": [0, 1, 0, 0],
                           "v": [1, 2, 3, 4]})
     rows = fig5.role_rows(table, "B")
     assert rows["v"].tolist() == [2, 3]
-    assert "A_alone" not in rows["condition"].cat.categories
+    assert not any(c.startswith("A_alone") for c in rows["condition"].cat.categories)
     with pytest.raises(ValueError, match="role must be"):
         fig5.role_rows(table, "C")
 
@@ -98,7 +106,12 @@ def test_food_of_b_draws_b_food_of_every_condition(synthetic_results):
     ax = draw("fig5/E", synthetic_results, tables)
     assert np.array_equal(point_values(ax), np.sort(expected))
     labels = [t.get_text() for t in ax.get_xticklabels()]
-    assert labels == ["A<B", "A=B", "A>B", "B alone"]
+    # each size class beside B alone at the size B has in it, an empty slot between classes
+    assert labels == ["A<B", "B alone\n0.75", "", "A=B", "B alone\n0.5", "", "A>B", "B alone\n0.25"]
+    for i, cond in [(0, "A_lt_B"), (1, "B_alone_75"), (6, "A_gt_B"), (7, "B_alone_25")]:
+        mine = fig5.role_rows(food, "B").query("condition == @cond")["food_eaten"].to_numpy(float)
+        ys = [off[np.abs(off[:, 0] - i) < 0.4, 1] for c in ax.collections if len(off := c.get_offsets())]
+        assert np.array_equal(np.sort(np.concatenate(ys)), np.sort(mine))
 
 
 def test_food_panels_read_their_stars_from_role_tests(synthetic_results):
@@ -107,11 +120,11 @@ def test_food_panels_read_their_stars_from_role_tests(synthetic_results):
     assert set(tests["role"].dropna()) == {"A", "B"}  # the real onepatch analysis wrote the table
     marked = tests.assign(stars=[f"S{i}" for i in range(len(tests))])
     ax = draw("fig5/E", synthetic_results, {**tables, "tests": marked})
-    b_rows = marked[marked["role"] == "B"].set_index("group")["stars"]
-    assert {t.get_text() for t in ax.texts} >= set(b_rows)  # each social box carries its own row's stars
-    ax = draw("fig5/F", synthetic_results, {**tables, "tests": marked})
-    a_row = marked.loc[marked["role"] == "A", "stars"].item()
-    assert any(t.get_text() == f"vs social: {a_row}" for t in ax.texts)
+    for role, key in (("B", "fig5/E"), ("A", "fig5/F")):
+        ax = draw(key, synthetic_results, {**tables, "tests": marked})
+        rows = marked[marked["role"] == role].set_index("group")["stars"]
+        assert len(rows) == 3  # one row per size class, against the alone control at the same size
+        assert sorted(t.get_text() for t in ax.texts) == sorted(rows)  # each class's bracket carries its own row
 
 
 @pytest.mark.parametrize(("key", "contrast"), [("fig5/I", "mobility"), ("fig5/J", "eod")])
@@ -127,9 +140,11 @@ def test_food_time_course_lines_are_the_table_means(synthetic_results):
     tables = load_tables(PANELS["fig5/H"], synthetic_results, 2)
     ax = draw("fig5/H", synthetic_results, tables)
     course = tables["course"]
-    mine = course[(course["condition"] == "A_alone") & (course["agent"] == 0)].sort_values("t")
-    line = next(line for line in ax.get_lines() if line.get_label() == "A alone")
+    mine = course[(course["condition"] == "A_alone_75") & (course["agent"] == 0)].sort_values("t")
+    line = next(line for line in ax.get_lines() if line.get_label() == "A alone, 0.75")
     assert np.allclose(line.get_ydata(), mine["mean_food"])
+    assert line.get_linestyle() == "--"  # alone controls dashed, the classes solid
+    assert next(line for line in ax.get_lines() if line.get_label() == "A>B").get_linestyle() == "-"
     fps = compose(["assay=onepatch"]).env.fps
     assert np.allclose(line.get_xdata(), mine["t"] / fps)
 

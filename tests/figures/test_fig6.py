@@ -33,12 +33,28 @@ def test_every_panel_renders_with_labelled_axes(key, synthetic_results, tmp_path
 
 
 def test_decoding_bars_are_the_scores_best_first_without_unscored_targets():
-    table = pd.DataFrame({"condition": "control", "target": ["eod", "dist_agent_cm", "size", "dist_food_cm"],
+    table = pd.DataFrame({"condition": "control", "target": ["log_morm_sensed", "dist_agent_cm", "size", "dist_food_cm"],
                           "score": [0.2, 0.6, np.nan, -0.1], "reason": ["", "", "constant target", ""]})
     ax = draw("fig6/E", {"decoding": table})
     widths = [p.get_width() for p in ax.patches if p.get_height() > 0]
     np.testing.assert_allclose(widths, [0.6, 0.2, -0.1])
-    assert [t.get_text() for t in ax.get_yticklabels()] == ["nearest agent: distance", "own EOD", "food: distance"]
+    assert [t.get_text() for t in ax.get_yticklabels()] == ["nearest agent: distance", "log reading (M, sensed)",
+                                                            "food: distance"]
+
+
+@pytest.mark.parametrize("with_column", [True, False])
+def test_readouts_are_drawn_hatched_below_the_sensed_targets_and_not_ranked_among_them(with_column):
+    """CLAIMS rule 7: the own turn, EOD and size are drawn as readouts, after every sensed target, even when
+    they score best; a table without the readout column (an earlier run) is marked by target."""
+    table = pd.DataFrame({"condition": "control", "target": ["turn_rad", "dist_agent_cm", "eod", "dist_wall_cm"],
+                          "readout": [True, False, True, False], "score": [0.8, 0.3, 0.6, 0.1], "reason": ""})
+    ax = draw("fig6/E", {"decoding": table if with_column else table.drop(columns="readout")})
+    bars = [p for p in ax.patches if p.get_height() > 0]
+    np.testing.assert_allclose([p.get_width() for p in bars], [0.3, 0.1, 0.8, 0.6])
+    assert [t.get_text() for t in ax.get_yticklabels()] == ["nearest agent: distance", "wall: distance",
+                                                            "turn (readout)", "own EOD (readout)"]
+    assert [bool(p.get_hatch()) for p in bars] == [False, False, True, True]
+    assert any(line.get_linestyle() == "--" for line in ax.get_lines())  # the line between the two groups
 
 
 def test_decoding_without_any_score_says_why():

@@ -56,8 +56,13 @@ def assays():
 
 def test_interventions_are_visible_in_the_data(assays):
     mute = assays["mute"]["steps"]
-    assert not mute[(mute.condition == "muted") & (mute.agent == 0)]["eod"].any()
-    assert mute[(mute.condition == "intact") & (mute.agent == 0)]["eod"].all()
+    # the Results' design mutes agent 1 of 2, the Methods' agent 0 of 4
+    assert not mute[(mute.condition == "muted") & (mute.agent == 1)]["eod"].any()
+    assert mute[(mute.condition == "intact") & (mute.agent == 1)]["eod"].all()
+    assert not mute[(mute.condition == "muted4") & (mute.agent == 0)]["eod"].any()
+    assert mute[(mute.condition == "intact4") & (mute.agent == 0)]["eod"].all()
+    assert mute.groupby("condition")["agent"].nunique().to_dict() == {"intact": 2, "muted": 2, "intact4": 4,
+                                                                      "muted4": 4}
     ablation = assays["ablation4"]["steps"].set_index("condition")
     assert (ablation.loc["A_K", "morm_abs_mean"] == 0).all() and (ablation.loc["M_K", "amp_abs_mean"] == 0).all()
     assert (ablation.loc["M_A", "knollen_spikes"] == 0).all() and (ablation.loc["none", "n_knollen_agents"] == 0).all()
@@ -70,7 +75,7 @@ def test_interventions_are_visible_in_the_data(assays):
     assert (frozen.groupby(["condition", "episode"])["x_cm"].nunique() == 1).all()
     groups = assays["groupsize"]["steps"].groupby(["condition", "episode", "t"])["agent"].nunique()
     assert all(groups[c].eq(int(c[1])).all() for c in groups.index.get_level_values(0).unique())
-    assert set(assays["onepatch"]["steps"].query("condition == 'A_alone'")["agent"]) == {0}
+    assert set(assays["onepatch"]["steps"].query("condition == 'A_alone_75'")["agent"]) == {0}
 
 
 def test_starts_follow_the_assay(assays):

@@ -38,10 +38,12 @@ use rule assay as assay_with_hidden with:
         assay="|".join(HIDDEN_ASSAYS) or "^$",
 
 
-# The supplement's top-3 panels: the best-ranked seeds also run scale.top_seed_assays.
-rule top_seed_assay:
-    input:
-        "results/{run}/train/seed_{seed}/final.pt",
+# The best-ranked seeds (scale.top_seeds, from the select_seed checkpoint's ranking) rerun assays with their own
+# checkpoint as the `selected` policy, into results/{run}/seeds/seed_{seed}/assays/{assay}/ (the layout of
+# results/{run}/assays/): every top seed runs scale.top_seed_assays for the supplement's top-seed panels, and each
+# top seed other than the selected one also runs every claim's assay (common.smk: SEED_CLAIM_ASSAYS) for its own
+# claims table (CLAIMS.md rule 4). The selected seed's rules, whose inputs (assay_policies_input) read {seed}.
+use rule assay as top_seed_assay with:
     output:
         steps="results/{run}/seeds/seed_{seed}/assays/{assay}/steps.parquet",
         episodes="results/{run}/seeds/seed_{seed}/assays/{assay}/episodes.parquet",
@@ -50,17 +52,21 @@ rule top_seed_assay:
         "results/{run}/logs/seeds/seed_{seed}/{assay}.log",
     benchmark:
         "results/{run}/benchmarks/seeds/seed_{seed}/{assay}.tsv"
-    params:
-        overrides=ARGS,
-        out=folder_of("steps"),
-    threads: 1
-    conda:
-        "../envs/efish.yaml"
-    shell:
-        "efish assay assay={wildcards.assay} {params.overrides} --policy selected={input} "
-        "--out {params.out} > {log} 2>&1"
+    wildcard_constraints:
+        assay="|".join(a for a in TOP_SEED_ASSAYS if a not in TOP_SEED_HIDDEN) or "^$",
 
 
+use rule top_seed_assay as top_seed_assay_with_hidden with:
+    output:
+        steps="results/{run}/seeds/seed_{seed}/assays/{assay}/steps.parquet",
+        episodes="results/{run}/seeds/seed_{seed}/assays/{assay}/episodes.parquet",
+        food="results/{run}/seeds/seed_{seed}/assays/{assay}/food.parquet",
+        hidden="results/{run}/seeds/seed_{seed}/assays/{assay}/hidden.parquet",
+    wildcard_constraints:
+        assay="|".join(TOP_SEED_HIDDEN) or "^$",
+
+
+# The supplement's top-seed panels: the top seeds' episodes in scale.top_seed_assays, stacked with seed and rank.
 rule top_seeds:
     input:
         tables=top_seed_tables,

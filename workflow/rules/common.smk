@@ -8,6 +8,7 @@ import shlex
 import sys
 from pathlib import Path
 
+from efish.analysis.claim_parts import analysis_table
 from efish.analysis.claims import claim_tables, produced_tables
 from efish.analysis.registry import ANALYSES, analyses_for, tables_written
 from efish._numba_cache import source_digest
@@ -102,6 +103,24 @@ ASSAY_ANALYSES = {name: analyses_for(name, tables_written(assay_config(name).ass
 DRAWABLE = drawable(CFG.scale)
 
 
+def claims_read(names):
+    """The tables the claims read among those assays ``names`` write, as paths under ``results/{run}/``."""
+    produced = produced_tables({name: assay_config(name).assay for name in names})
+    return [path for path in claim_tables() if path in produced]
+
+
+# Verdicts across seeds (rule 4 of CLAIMS.md). Each top seed other than the selected one reruns every claim's assay,
+# i.e. every assay of the scale that some claim reads and whose conditions act (at least in part) with the selected
+# policy, into results/{run}/seeds/seed_{n}/ with the layout of results/{run}/, and only the analyses the claims
+# read. An assay acted only by recipe policies (homing) gives the same tables for every seed: not rerun; its claims
+# are "not run" for the other seeds.
+SEED_CLAIM_ASSAYS = [name for name in ASSAYS if "selected" in ASSAY_POLICIES[name] and claims_read([name])]
+SEED_CLAIM_TABLES = claims_read(SEED_CLAIM_ASSAYS)
+# Every assay a top seed may run under results/{run}/seeds/seed_{n}/assays/: the claims' and the supplement's.
+TOP_SEED_ASSAYS = sorted({*SEED_CLAIM_ASSAYS, *CFG.scale.top_seed_assays})
+TOP_SEED_HIDDEN = [name for name in TOP_SEED_ASSAYS if assay_config(name).assay.record_hidden]
+
+
 wildcard_constraints:
     run=re.escape(RUN),
     seed=r"\d+",
@@ -114,14 +133,28 @@ def folder_of(name, up=0):
     return lambda wildcards, output: str(Path(output[name]).parents[up])
 
 
-def analysis_inputs(analysis):
-    """The rollout tables an analysis reads, by name, for the {assay} wildcard."""
-    return {t: f"results/{{run}}/assays/{{assay}}/{t}.parquet" for t in analysis.reads}
+def seed_folder(seed=None):
+    """Where a top seed other than the selected one keeps the layout of results/{run}/: '' for the run's own
+    (the selected seed's) outputs, 'seeds/seed_<seed>/' for another seed's (``seed`` may be '{seed}')."""
+    return "" if seed is None else f"seeds/seed_{seed}/"
 
 
-def analysis_outputs(analysis, run="{run}", assay="{assay}"):
-    """The tables an analysis writes, by name: results/{run}/analysis/<analysis>/{assay}/<table>.parquet."""
-    return {t: f"results/{run}/analysis/{analysis.name}/{assay}/{t}.parquet" for t in analysis.outputs}
+def analysis_inputs(analysis, seed=None):
+    """The rollout tables an analysis reads, by name, for the {assay} wildcard (of top seed ``seed``)."""
+    return {t: f"results/{{run}}/{seed_folder(seed)}assays/{{assay}}/{t}.parquet" for t in analysis.reads}
+
+
+def analysis_outputs(analysis, run="{run}", assay="{assay}", seed=None):
+    """The tables an analysis writes, by name: results/{run}/analysis/<analysis>/{assay}/<table>.parquet, or
+    results/{run}/seeds/seed_<seed>/analysis/... for another top seed."""
+    return {t: f"results/{run}/{seed_folder(seed)}analysis/{analysis.name}/{assay}/{t}.parquet"
+            for t in analysis.outputs}
+
+
+def seed_analysis_assays(analysis):
+    """The assays the other top seeds rerun whose ``analysis`` tables some claim reads (only those analyses run)."""
+    return [a for a in SEED_CLAIM_ASSAYS if any(analysis_table(analysis.name, a, t) in SEED_CLAIM_TABLES
+                                                for t in analysis.outputs)]
 
 
 def panel_inputs(panel):
@@ -137,9 +170,16 @@ def selected_policy(wildcards):
 
 
 def assay_policies_input(wildcards):
-    """The final checkpoint of every policy an assay's conditions act with, by policy name."""
-    return {name: selected_policy(wildcards) if name == "selected" else f"results/{wildcards.run}/train/{name}/final.pt"
-            for name in ASSAY_POLICIES[wildcards.assay]}
+    """The final checkpoint of every policy an assay's conditions act with, by policy name. The ``selected`` policy
+    is the seed the select_seed checkpoint chose, or seed {seed} for a top seed's run (results/{run}/seeds/)."""
+    seed = getattr(wildcards, "seed", None)
+
+    def path(name):
+        if name != "selected":
+            return f"results/{wildcards.run}/train/{name}/final.pt"
+        return selected_policy(wildcards) if seed is None else f"results/{wildcards.run}/train/seed_{seed}/final.pt"
+
+    return {name: path(name) for name in ASSAY_POLICIES.get(wildcards.assay, ["selected"])}
 
 
 def policy_args(wildcards, input):
@@ -153,6 +193,23 @@ def top_seeds(wildcards):
 
     ranking = pd.read_parquet(checkpoints.select_seed.get(run=wildcards.run).output.ranking)
     return [int(s) for s in ranking["seed"].head(CFG.scale.top_seeds)]
+
+
+def other_top_seeds(wildcards):
+    """The top seeds other than the selected one (the ranking's first row), best first: each reruns every claim's
+    assay under results/{run}/seeds/seed_{n}/ for its own claims table."""
+    return top_seeds(wildcards)[1:]
+
+
+def other_seed_claims(wildcards):
+    """The claims tables of the other top seeds, in ranking order (the claims rule combines them)."""
+    return [f"results/{wildcards.run}/seeds/seed_{seed}/claims/claims.parquet" for seed in other_top_seeds(wildcards)]
+
+
+def seed_claims_args(wildcards, input):
+    """efish claims's --ranking and --seed-claims SEED=PATH of the other top seeds (none: the selected seed alone)."""
+    pairs = [f"{seed}={path}" for seed, path in zip(other_top_seeds(wildcards), other_seed_claims(wildcards))]
+    return " ".join([f"--ranking {input.ranking} --seed-claims", *pairs])
 
 
 def top_seed_tables(wildcards):
@@ -185,9 +242,11 @@ def render_targets():
 
 
 def claims_inputs(wildcards):
-    """The claims' tables among those the assays of this scale write (rollout tables and their analyses)."""
-    produced = produced_tables({name: assay_config(name).assay for name in ASSAYS})
-    return [f"results/{wildcards.run}/{path}" for path in claim_tables() if path in produced]
+    """The claims' tables among those the assays of this scale write (rollout tables and their analyses); for a top
+    seed's claims (wildcard {seed}) those its rerun assays write under results/{run}/seeds/seed_{seed}/."""
+    seed = getattr(wildcards, "seed", None)
+    paths = claims_read(ASSAYS) if seed is None else SEED_CLAIM_TABLES
+    return [f"results/{wildcards.run}/{seed_folder(seed)}{path}" for path in paths]
 
 
 def all_targets():

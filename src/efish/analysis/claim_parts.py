@@ -9,10 +9,17 @@ Verdicts (CLAIMS.md): **holds** = the paper's sign and p < alpha; **weaker** =
 the paper's sign but not significant (an effect of the opposite sign that is not
 significant is also weaker: nothing refutes the claim, and the reason says so);
 **fails** = the opposite sign and significant, or a criterion that cannot hold;
-**not run** = no table or no testable data, with the reason. A part the paper
-reports as *not significant* (K-off food in C10) holds when p >= alpha and fails
-when p < alpha. Every test here is two-sided, so that an effect of the opposite
-sign can be significant.
+**not decidable** = the data cannot carry the test (a condition at a ceiling
+or floor), with the reason; **not run** = no table or no testable data, with
+the reason. A part the paper reports as *no difference* (K-off food in C10)
+holds when it is *shown equivalent*: its two one-sided tests (TOST) within the
+part's margin give p < alpha; it fails when the difference is significant and
+larger than the margin; otherwise it is weaker. Every difference test here is
+two-sided, so that an effect of the opposite sign can be significant.
+
+A part may be reported *beside* a claim without deciding it (``decides=False``,
+e.g. the Methods' 4-agent mute design beside the Results' 2-agent one): its
+verdict is shown in the reason, the claim's verdict ignores it.
 
 Also here, the statistics a claim needs that no analysis table has: an OLS
 slope with its p, a one-sample Wilcoxon (via :func:`efish.analysis.stats.wilcoxon_paired`),
@@ -21,6 +28,7 @@ Fisher's exact test of two rates and the held-out decoding skill per episode.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
@@ -31,10 +39,18 @@ from scipy import stats as sps
 
 from ..config.schema import EfishConfig
 from ._tables import AGENT_EPISODE
+from .claim_stats import (
+    at_ceiling,
+    equivalence_margin,
+    paired_vs_control,
+    pooled_sd,
+    tost_paired,
+    tost_unpaired,
+)
 from .dynamics import units
 from .stats import mann_whitney, spearman, wilcoxon_paired
 
-VERDICTS = ("holds", "weaker", "fails", "not run")
+VERDICTS = ("holds", "weaker", "fails", "not decidable", "not run")
 ROW_COLUMNS = ["claim", "panel", "statistic", "effect", "ci_low", "ci_high", "n", "p", "verdict", "reason"]
 NAN_CI = (np.nan, np.nan)
 
@@ -55,7 +71,9 @@ class Outcome:
 
     ``sign``: +1 or -1, the direction the paper reports; 0, the paper reports no
     difference (holds when n.s.); None, any difference (holds when significant).
-    ``verdict`` overrides the rule for a part decided by a criterion, not a test.
+    ``verdict`` overrides the rule for a part decided by a criterion, not a test
+    (or "not decidable" at a ceiling). For ``sign`` 0, ``p_equiv`` is the TOST
+    p within ``margin`` (in the effect's units) and ``p`` the difference test's.
     """
 
     effect: float
@@ -65,6 +83,8 @@ class Outcome:
     ci: tuple[float, float] = NAN_CI
     reason: str = ""
     verdict: str | None = None
+    p_equiv: float = np.nan
+    margin: float = np.nan
 
 
 @dataclass(frozen=True)
@@ -79,19 +99,29 @@ class Part:
     p: float = np.nan
     verdict: str = "not run"
     reason: str = ""
+    decides: bool = True
 
 
-def judge(effect: float, p: float, sign: int | None, alpha: float) -> tuple[str, str]:
+def judge(effect: float, p: float, sign: int | None, alpha: float, p_equiv: float = np.nan,
+          margin: float = np.nan) -> tuple[str, str]:
     """Verdict and a short reason from an effect, its two-sided p and the paper's sign (module docstring).
 
-    >>> judge(0.3, 0.01, +1, 0.05), judge(-0.3, 0.01, +1, 0.05)[0], judge(0.3, 0.2, 0, 0.05)[0]
-    (('holds', ''), 'fails', 'holds')
+    >>> judge(0.3, 0.01, +1, 0.05), judge(-0.3, 0.01, +1, 0.05)[0]
+    (('holds', ''), 'fails')
+    >>> [judge(e, p, 0, 0.05, pe, 1.0)[0] for e, p, pe in ((0.1, 0.6, 0.01), (2.0, 0.01, 0.9), (0.3, 0.6, 0.3))]
+    ['holds', 'fails', 'weaker']
     """
     significant = p < alpha
     if sign is None:
         return ("holds", "") if significant else ("weaker", f"not significant (p = {p:.3g})")
     if sign == 0:
-        return ("holds", "") if not significant else ("fails", f"significant (p = {p:.3g}); the paper reports none")
+        within = f"within +-{margin:.3g}"
+        if p_equiv < alpha:
+            return "holds", f"shown equivalent {within} (TOST p = {p_equiv:.3g}; difference p = {p:.3g})"
+        if significant and abs(effect) > margin:
+            return "fails", f"a significant difference (p = {p:.3g}) beyond the margin {within}; the paper reports none"
+        return "weaker", (f"neither shown equivalent {within} (TOST p = {p_equiv:.3g}) nor different beyond it "
+                          f"(p = {p:.3g})")
     direction = np.sign(effect) * sign
     if direction > 0:
         return ("holds", "") if significant else ("weaker", f"the paper's sign, not significant (p = {p:.3g})")
@@ -101,31 +131,44 @@ def judge(effect: float, p: float, sign: int | None, alpha: float) -> tuple[str,
     return "weaker", "zero effect"
 
 
-def evaluate(label: str, statistic: str, compute: Callable[[], Outcome], alpha: float) -> Part:
-    """Run one part: a missing table or degenerate data (ValueError) is a ``not run`` part whose reason says why."""
+def evaluate(label: str, statistic: str, compute: Callable[[], Outcome], alpha: float, decides: bool = True) -> Part:
+    """Run one part: a missing table or degenerate data (ValueError) is a ``not run`` part whose reason says why.
+
+    The part's ``p`` is the one its verdict rests on: the TOST p for a "no
+    difference" part (sign 0), else the difference test's.
+    """
     try:
         out = compute()
     except (MissingTable, ValueError) as exc:
-        return Part(label, statistic, reason=str(exc).strip("'\""))
+        return Part(label, statistic, reason=str(exc).strip("'\""), decides=decides)
     except KeyError as exc:  # a table from an older run without a column this claim reads
-        return Part(label, statistic, reason=f"a table lacks the column or key {exc}")
-    base = Part(label, statistic, float(out.effect), tuple(map(float, out.ci)), int(out.n), float(out.p))
+        return Part(label, statistic, reason=f"a table lacks the column or key {exc}", decides=decides)
+    p = out.p_equiv if out.sign == 0 and out.verdict is None else out.p
+    base = Part(label, statistic, float(out.effect), tuple(map(float, out.ci)), int(out.n), float(p), decides=decides)
     if out.verdict is not None:
         return Part(**{**base.__dict__, "verdict": out.verdict, "reason": out.reason})
-    if not (np.isfinite(out.effect) and np.isfinite(out.p)):
+    if not (np.isfinite(out.effect) and np.isfinite(p)):
         return Part(**{**base.__dict__, "verdict": "not run", "reason": out.reason or "no test result"})
-    verdict, why = judge(out.effect, out.p, out.sign, alpha)
+    verdict, why = judge(out.effect, out.p, out.sign, alpha, out.p_equiv, out.margin)
     return Part(**{**base.__dict__, "verdict": verdict, "reason": "; ".join(r for r in (why, out.reason) if r)})
 
 
 def combined_verdict(verdicts: Iterable[str]) -> str:
-    """A claim's verdict from its parts': any fails -> fails; all hold -> holds; none ran -> not run; else weaker."""
+    """A claim's verdict from its deciding parts': any fails -> fails; all that could be decided hold -> holds;
+    a part not run (a missing table) makes holds weaker; nothing decidable -> not decidable; none ran -> not run.
+
+    >>> combined_verdict(["holds", "not decidable"]), combined_verdict(["holds", "not run"])
+    ('holds', 'weaker')
+    >>> combined_verdict(["not decidable", "not run"]), combined_verdict(["weaker", "fails"])
+    ('not decidable', 'fails')
+    """
     v = list(verdicts)
-    if not v or all(x == "not run" for x in v):
-        return "not run"
-    if "fails" in v:
+    decided = [x for x in v if x in ("holds", "weaker", "fails")]
+    if not decided:
+        return "not decidable" if "not decidable" in v else "not run"
+    if "fails" in decided:
         return "fails"
-    return "holds" if all(x == "holds" for x in v) else "weaker"
+    return "holds" if all(x in ("holds", "not decidable") for x in v) else "weaker"
 
 
 def _fmt(x: float) -> str:
@@ -136,19 +179,22 @@ def combine(claim: str, panel: str, parts: list[Part]) -> dict:
     """The claim's row: its verdict over all parts; effect, interval, n and p of the first part that ran.
 
     With several parts the reason lists each: ``label: verdict (effect, p)``
-    and its own reason, so the row says which statement carried the verdict.
+    and its own reason, so the row says which statement carried the verdict;
+    a part reported beside the claim (``decides`` False) is marked so and does
+    not enter the verdict.
     """
-    shown = next((p for p in parts if p.verdict != "not run"), parts[0])
+    deciding = [p for p in parts if p.decides] or parts
+    shown = next((p for p in deciding if p.verdict not in ("not run", "not decidable")), deciding[0])
     if len(parts) == 1:
         reason = shown.reason
     else:
-        reason = "; ".join(f"{p.label}: {p.verdict}" + (f" (effect {_fmt(p.effect)}, p {_fmt(p.p)})"
-                                                        if p.verdict != "not run" else "")
+        reason = "; ".join(f"{p.label}{'' if p.decides else ' (beside, not deciding)'}: {p.verdict}"
+                           + (f" (effect {_fmt(p.effect)}, p {_fmt(p.p)})" if np.isfinite(p.effect) else "")
                            + (f" [{p.reason}]" if p.reason else "") for p in parts)
     statistic = shown.statistic if len(parts) == 1 else f"{shown.label}: {shown.statistic}"
     return {"claim": claim, "panel": panel, "statistic": statistic, "effect": shown.effect,
             "ci_low": shown.ci[0], "ci_high": shown.ci[1], "n": shown.n, "p": shown.p,
-            "verdict": combined_verdict(p.verdict for p in parts), "reason": reason}
+            "verdict": combined_verdict(p.verdict for p in deciding), "reason": reason}
 
 
 # ---------------------------------------------------------------- bootstrap
@@ -317,8 +363,8 @@ class Context:
         n = self.cfg.analysis.claims_resamples if resamples is None else resamples
         return bootstrap_ci(data, stat, list(units_), n, self.rng, strata)
 
-    def part(self, label: str, statistic: str, compute: Callable[[], Outcome]) -> Part:
-        return evaluate(label, statistic, compute, self.cfg.analysis.claims_alpha)
+    def part(self, label: str, statistic: str, compute: Callable[[], Outcome], decides: bool = True) -> Part:
+        return evaluate(label, statistic, compute, self.cfg.analysis.claims_alpha, decides)
 
 
 @dataclass(frozen=True)
@@ -439,10 +485,64 @@ def joined(ctx: Context, hidden: str, steps: str, columns: list[str]) -> tuple[p
     return h.merge(s[keys + columns], on=keys).sort_values(keys, kind="stable"), units(h)
 
 
-def paired_skill(ctx: Context, skills: pd.DataFrame, better: str, worse: str, sign: int = +1) -> Outcome:
-    """Paired Wilcoxon over episodes of held-out skill, ``better`` minus ``worse``, interval over episodes."""
-    long = skills.rename(columns={"group": "episode"})
+def paired_difference(ctx: Context, long: pd.DataFrame, better: str, worse: str, value: str = "skill",
+                      key: str = "target", unit: str = "group", sign: int = +1) -> Outcome:
+    """Paired Wilcoxon over ``unit`` (episodes) of ``value`` where ``key`` is ``better`` minus where it is ``worse``
+    (e.g. two decoding targets' held-out skill), with an interval over the units."""
+    long = long.rename(columns={unit: "episode", key: "target", value: "skill"})
     row = wilcoxon_paired(long, "skill", "target", worse, "episode").set_index("group").loc[better]
     wide = long.pivot(index="episode", columns="target", values="skill")
     diff = (wide[better] - wide[worse]).dropna().rename("diff").reset_index()
     return from_row(row, sign, ctx.ci(diff, median_minus("diff", 0.0), strata=None))
+
+
+# ------------------------------------------------- paired and equivalence parts (CLAIMS rules 2, 3, 5)
+def margin_for(ctx: Context, control: np.ndarray, other: np.ndarray) -> tuple[float, str]:
+    """The equivalence margin of an "n.s." part from the config (:func:`efish.analysis.claim_stats.equivalence_margin`)."""
+    a = ctx.cfg.analysis
+    c, o = (np.asarray(v, np.float64) for v in (control, other))
+    sd = pooled_sd(c[np.isfinite(c)], o[np.isfinite(o)])
+    return equivalence_margin(c, sd, a.claims_margin_fraction, a.claims_margin_sd)
+
+
+def paired_part(ctx: Context, summary: pd.DataFrame, measure: str, condition: str, control: str,
+                sign: int, family: Iterable[str] | None = None) -> Outcome:
+    """``condition`` vs ``control`` paired over their shared episodes (rule 2): Wilcoxon signed-rank, Holm-adjusted
+    over ``family`` (default: every condition of ``summary``) compared with the same control; effect = median paired
+    difference with a bootstrap interval over episodes. For ``sign`` 0 also the paired TOST within the margin."""
+    present(summary, "condition", [condition, control], f"episodes with {measure}")
+    family = list(summary["condition"].unique()) if family is None else [*family, control]
+    rows = paired_vs_control(summary[summary["condition"].isin(family)], measure, control)
+    row = rows.set_index("group").loc[condition]
+    wide = summary[summary["condition"].isin([condition, control])].pivot(index="episode", columns="condition",
+                                                                          values=measure).astype(np.float64)
+    both = wide[[condition, control]].dropna()
+    diff = (both[condition] - both[control]).rename("diff").reset_index()
+    ci = ctx.ci(diff, median_minus("diff", 0.0), strata=None)
+    note = f"paired over {len(both)} shared episodes, Holm over {len(rows)} conditions vs {control}"
+    out = from_row(row, sign, ci)
+    if sign == 0:
+        margin, how = margin_for(ctx, both[control].to_numpy(), both[condition].to_numpy())
+        out = dataclasses.replace(out, p_equiv=tost_paired(diff["diff"].to_numpy(), margin), margin=margin)
+        note += f"; margin {margin:.3g} = {how}"
+    return dataclasses.replace(out, reason="; ".join(r for r in (out.reason, note) if r))
+
+
+def unpaired_equivalence(ctx: Context, frame: pd.DataFrame, value: str, group: str, a, b) -> Outcome:
+    """Mann-Whitney of ``value``, ``a`` vs ``b`` (the control), and the unpaired TOST within the margin (rule 3)."""
+    out = mann_whitney_part(ctx, frame, value, group, a, b, 0)
+    x, c = (frame.loc[frame[group] == g, value].to_numpy(np.float64) for g in (a, b))
+    margin, how = margin_for(ctx, c, x)
+    return dataclasses.replace(out, p_equiv=tost_unpaired(x, c, margin), margin=margin,
+                               reason="; ".join(r for r in (out.reason, f"margin {margin:.3g} = {how}") if r))
+
+
+def ceiling(ctx: Context, summary: pd.DataFrame, food: pd.DataFrame, conditions: Iterable[str]) -> Outcome | None:
+    """A "not decidable" outcome when one of ``conditions`` ate every pellet in most episodes (rule 5), else None."""
+    share = ctx.cfg.analysis.claims_ceiling_share
+    for condition in conditions:
+        full, how = at_ceiling(summary, food, condition, share)
+        if full:
+            return Outcome(np.nan, np.nan, int((summary["condition"] == condition).sum()), None,
+                           verdict="not decidable", reason=f"at a ceiling: {how}, so no food difference can appear")
+    return None

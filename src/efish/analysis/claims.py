@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import re
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 
@@ -30,6 +29,7 @@ from scipy import stats as sps
 
 from ..config.schema import AssayConfig, EfishConfig
 from ..io import read_parquet
+from . import claims_fig4  # noqa: F401  (registers C10-C13)
 from ._tables import AGENT_EPISODE, eod_rate
 from .claim_parts import (
     CLAIMS,
@@ -48,34 +48,26 @@ from .claim_parts import (
     median_minus,
     ols_part,
     one_sample_part,
-    paired_skill,
+    paired_difference,
     present,
     rho_of,
     rollout_table,
     slope,
     spearman_part,
     stat_row,
+    unpaired_equivalence,
 )
+from .claim_stats import interaction_slope
 from .dynamics import DECODE_TARGETS, plsc
 from .dynamics_tests import groupsize_parts, smaller_larger
 from .homing import error_angles
 from .interactions import bite_rate_by_class
 from .onepatch import REACH_CONTRASTS, SOCIAL, bot_reach_counts, roles
 from .registry import ANALYSES, tables_written
-from .signalling import EVENTS, peri_event_rate
-from .stats import fisher_rates, spearman
+from .signalling import EVENTS, fit_power_law, peri_event_rate
+from .stats import spearman
 
 __all__ = ["CLAIMS", "ROW_COLUMNS", "claim_tables", "claims_table", "produced_tables"]
-
-
-# ---------------------------------------------------------- shared tests
-def _dunnett(ctx: Context, assay: str, condition: str, control: str, measure: str, sign: int) -> Outcome:
-    """The behaviour analysis's Dunnett row (mean difference vs control), interval over its episode summary."""
-    tests = ctx.table(analysis_table("behaviour", assay, "condition_tests"))
-    summary = ctx.table(analysis_table("behaviour", assay, "episode_summary"))
-    row = stat_row(tests, measure=measure, group=condition, control=control)
-    sub = summary[summary["condition"].isin([condition, control])]
-    return from_row(row, sign, ctx.ci(sub, mean_diff(measure, "condition", condition, control)))
 
 
 # --------------------------------------------------------------- Fig 2
@@ -115,22 +107,36 @@ def _knollen_errors(ctx: Context) -> pd.DataFrame:
     return err
 
 
+def _aligned_fraction(err: np.ndarray, a: float) -> float:
+    """Fraction of angles within ``a`` of 0 or pi (|cos e| > cos a)."""
+    return float(np.mean(np.abs(np.cos(err)) > np.cos(a)))
+
+
 @claim("C2", "2C", "the error angle is bimodal near parallel and anti-parallel to the target's field",
        [HOMING_STEPS])
 def c2(ctx: Context) -> list[Part]:
     a = ctx.cfg.analysis.claims_aligned_rad
-    chance = 2 * a / np.pi  # P(|cos e| > cos a) for a uniform angle e
 
     def compute() -> Outcome:
         err = _knollen_errors(ctx)
-        per = (err.assign(aligned=np.abs(np.cos(err["err_rad"])) > np.cos(a))
-               .groupby(["episode", "agent"], as_index=False)["aligned"].agg(k="sum", n="size"))
-        k, n = int(per["k"].sum()), int(per["n"].sum())
-        p = sps.binomtest(k, n, chance).pvalue
-        ci = ctx.ci(per, lambda d: d["k"].sum() / d["n"].sum() - chance)
-        return Outcome(k / n - chance, p, n, +1, ci, f"aligned fraction {k / n:.3f} vs chance {chance:.3f}")
-    return [ctx.part("aligned fraction", f"fraction of homing steps with |cos(err_knollen)| > cos({a:.3g}) minus "
-                     "its chance value; binomial test", compute)]
+        steps = ctx.table(HOMING_STEPS)[[*AGENT_EPISODE, "t", "success", "bearing_agent_rad"]]
+        err = _successful(err.merge(steps, on=[*AGENT_EPISODE, "t"]))
+        if err.empty:
+            raise ValueError("no successful electric homing episode")
+        # a homer heading straight at the target from the same position: heading + bearing to the target, so
+        # its error angle is the observed one plus the bearing (the geometric null of this statistic)
+        straight = err["err_rad"] + err["bearing_agent_rad"]
+        per = (err.assign(observed=np.abs(np.cos(err["err_rad"])) > np.cos(a),
+                          straight=np.abs(np.cos(straight)) > np.cos(a))
+               .groupby(["episode", "agent"], as_index=False)[["observed", "straight"]].mean())
+        per = per.assign(excess=per["observed"] - per["straight"])
+        out = one_sample_part(ctx, per, "excess", 0.0, +1)
+        note = (f"median aligned fraction {per['observed'].median():.3f} vs {per['straight'].median():.3f} for a "
+                f"straight homer on the same positions, over {len(per)} successful episodes")
+        return dataclasses.replace(out, reason="; ".join(r for r in (out.reason, note) if r))
+    return [ctx.part("aligned beyond straight homing", f"median over successful episodes of the fraction of steps "
+                     f"with |cos(err_knollen)| > cos({a:.3g}) minus that of a homer heading straight at the target "
+                     "from the same positions; Wilcoxon vs 0", compute)]
 
 
 @claim("C3", "2D", "error angles align progressively during successful episodes", [HOMING_STEPS])
@@ -152,36 +158,29 @@ def c3(ctx: Context) -> list[Part]:
 POWER_LAW, IDIS = analysis_table("signalling", "wide2", "power_law"), analysis_table("signalling", "wide2", "idis")
 
 
-def _r_exponential(idi_ms: np.ndarray, xmin: float) -> float:
-    """powerlaw's normalised loglikelihood ratio power law vs exponential (as in fit_power_law), for resamples."""
-    import warnings
-
-    import powerlaw
-
-    x = idi_ms[np.isfinite(idi_ms) & (idi_ms > 0)]
-    if np.sum(x >= xmin) < 10 or np.ptp(x[x >= xmin]) == 0:
-        return np.nan
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # the point estimate's fit reports powerlaw's warnings
-        return float(powerlaw.Fit(x, xmin=xmin, verbose=False).distribution_compare(
-            "power_law", "exponential", normalized_ratio=True)[0])
+def _r_exponential(idi_steps: np.ndarray, xmin: float) -> float:
+    """The discrete power law's normalised loglikelihood ratio against the exponential (the bootstrap's statistic)."""
+    fit = fit_power_law(idi_steps, xmin, discrete=True)
+    return fit["R_exponential"]
 
 
 @claim("C4", "3C,D", "IDIs are heavy-tailed, power-law-like", [POWER_LAW, IDIS])
 def c4(ctx: Context) -> list[Part]:
     def compute() -> Outcome:
-        fits = ctx.table(POWER_LAW)
-        row = stat_row(fits, source="agents")
-        xmin = float(row["xmin"])
+        row = stat_row(ctx.table(POWER_LAW), source="agents")
+        if not bool(row.get("discrete", False)):
+            raise ValueError("the power_law table holds a continuous fit: rerun the signalling analysis")
+        xmin = float(row["xmin_steps"])
         ids = ctx.table(IDIS)
         ids = ids[ids["condition"] == row["condition"]] if "condition" in ids.columns else ids
-        ci = ctx.ci(ids, lambda d: _r_exponential(d["idi_ms"].to_numpy(np.float64), xmin),
-                    resamples=ctx.cfg.analysis.claims_fit_resamples)
-        note = f"alpha {float(row['alpha']):.3g}, xmin {xmin:g} ms" if np.isfinite(row["alpha"]) else ""
+        ci = ctx.ci(ids, lambda d: _r_exponential(d["idi_steps"].to_numpy(np.float64), xmin),
+                    units_=("episode", "agent"), resamples=ctx.cfg.analysis.claims_fit_resamples)
+        note = f"alpha {float(row['alpha']):.3g}, xmin {xmin:g} steps" if np.isfinite(row["alpha"]) else ""
+        why = str(row.get("reason") or "")
         return Outcome(float(row["R_exponential"]), float(row["p_exponential"]), int(row["n"]), +1, ci,
-                       note if np.isfinite(row["R_exponential"]) else str(row.get("reason") or note))
-    return [ctx.part("power law", "normalised loglikelihood ratio R, power law vs exponential, IDIs >= xmin "
-                     "(wide2); powerlaw's p", compute)]
+                       "; ".join(r for r in (note, why) if r))
+    return [ctx.part("power law", "normalised loglikelihood ratio R of a discrete power law vs the exponential, "
+                     "IDIs in steps >= xmin (wide2; powerlaw discrete=True, as the authors); powerlaw's p", compute)]
 
 
 WIDE2_STEPS, WIDE2_HIDDEN = rollout_table("wide2", "steps"), rollout_table("wide2", "hidden")
@@ -283,9 +282,11 @@ def c8(ctx: Context) -> list[Part]:
         return from_row(row, +1, ctx.ci(per, lambda d: slope(d["size"], d["food_eaten"])))
 
     def theil() -> Outcome:
-        return ols_part(ctx, ctx.table(analysis_table("behaviour", "patchy4", "theil")), "size_theil_t", "theil_t", +1)
+        return spearman_part(ctx, ctx.table(analysis_table("behaviour", "patchy4", "theil")), "size_theil_t",
+                             "theil_t", +1)
     return [ctx.part("food ~ size", "OLS slope of food eaten on size over agent-episodes (patchy4)", food),
-            ctx.part("Theil ~ size Theil", "OLS slope of episode Theil T(food) on Theil T(size) (patchy4)", theil)]
+            ctx.part("Theil ~ size Theil", "Spearman rho of episode Theil T(food) against Theil T(size) (patchy4; "
+                     "OLS was decided by one high-leverage episode)", theil)]
 
 
 @claim("C9", "3O", "size correlates positively with EOD rate",
@@ -298,116 +299,35 @@ def c9(ctx: Context) -> list[Part]:
     return [ctx.part("rho", "Spearman rho(size, EOD probability) over agent-episodes (patchy4)", compute)]
 
 
-# --------------------------------------------------------------- Fig 4
-# ablation conditions are named by the receptor classes left on (config/assay/ablation4.yaml)
-ALL_ON, M_OFF, A_OFF, K_OFF = "M_A_K", "A_K", "M_K", "M_A"
-BEHAVIOUR = ("condition_tests", "episode_summary")
-
-
-def _dunnett_parts(ctx: Context, assay: str, control: str, specs) -> list[Part]:
-    stat = "mean difference of the episode {m} vs {c}; Dunnett"
-    return [ctx.part(label, stat.format(m=measure, c=control),
-                     functools.partial(_dunnett, ctx, assay, cond, control, measure, sign))
-            for label, cond, measure, sign in specs]
-
-
-@claim("C10", "4A-F", "short-range ablations cut food; Knollenorgan ablation keeps food, raises EOD probability "
-       "and biting, lowers spacing", [analysis_table("behaviour", a, t) for a in ("ablation4", "ablation1")
-                                      for t in BEHAVIOUR])
-def c10(ctx: Context) -> list[Part]:
-    return (_dunnett_parts(ctx, "ablation4", ALL_ON, [
-        ("group food, M off", M_OFF, "food_total", -1), ("group food, A off", A_OFF, "food_total", -1)])
-        + _dunnett_parts(ctx, "ablation1", ALL_ON, [
-            ("solo food, M off", M_OFF, "food_total", -1), ("solo food, A off", A_OFF, "food_total", -1)])
-        + _dunnett_parts(ctx, "ablation4", ALL_ON, [
-            ("group food, K off (n.s.)", K_OFF, "food_total", 0), ("EOD probability, K off", K_OFF,
-                                                                   "eod_probability", +1),
-            ("bites, K off", K_OFF, "bites", +1), ("nearest-neighbour distance, K off", K_OFF, "mean_nn_dist_cm",
-                                                   -1)]))
-
-
-@claim("C11", "4G,H", "self-only gating cuts food, cons-only does not; EOD lower in self-only, higher in cons-only",
-       [analysis_table("behaviour", "collective", t) for t in BEHAVIOUR])
-def c11(ctx: Context) -> list[Part]:
-    return _dunnett_parts(ctx, "collective", "control", [  # config/assay/collective.yaml
-        ("food, self-only", "self_only", "food_total", -1), ("food, cons-only (n.s.)", "cons_only", "food_total", 0),
-        ("EOD probability, self-only", "self_only", "eod_probability", -1),
-        ("EOD probability, cons-only", "cons_only", "eod_probability", +1)])
-
-
-@claim("C12", "4I,J", "muting one agent cuts group food and raises spacing",
-       [analysis_table("behaviour", "mute", "episode_summary")])
-def c12(ctx: Context) -> list[Part]:
-    def compute(measure: str, sign: int) -> Outcome:
-        summary = ctx.table(analysis_table("behaviour", "mute", "episode_summary"))
-        return mann_whitney_part(ctx, summary, measure, "condition", "muted", "intact", sign)  # config/assay/mute.yaml
-    stat = "median episode {} muted minus intact; Mann-Whitney"
-    return [ctx.part("group food", stat.format("food_total"), functools.partial(compute, "food_total", -1)),
-            ctx.part("spacing", stat.format("mean_nn_dist_cm"), functools.partial(compute, "mean_nn_dist_cm", +1))]
-
-
-NPATCH = re.compile(r"(iso|free)_(\d+)$")  # config/assay/npatch.yaml
-
-
-def _npatch(ctx: Context) -> pd.DataFrame:
-    """The iso episodes of the N-patch sweep with n, Theil T and food / mean food of the free series at that n."""
-    s = ctx.table(analysis_table("behaviour", "npatch", "episode_summary"))
-    m = s["condition"].astype(str).str.extract(NPATCH)
-    s = s.assign(series=m[0], n=pd.to_numeric(m[1]))
-    free = s[s["series"] == "free"].groupby("n")["food_total"].mean()
-    iso = s[s["series"] == "iso"]
-    if iso.empty or free.empty:
-        raise ValueError("the N-patch summary lacks the iso or the free series")
-    return iso.assign(food_ratio=iso["food_total"] / iso["n"].map(free).where(lambda v: v > 0))
-
-
-@claim("C13", "4K-N", "patchy food yields more than uniform, Theil n.s.; fewer patches at fixed total food lower "
-       "intake and inequality", [analysis_table("behaviour", a, "episode_summary")
-                                 for a in ("patchy4", "uniform4", "npatch")])
-def c13(ctx: Context) -> list[Part]:
-    def layouts(measure: str, sign: int) -> Outcome:
-        both = pd.concat([ctx.table(analysis_table("behaviour", a, "episode_summary")).assign(layout=a)
-                          for a in ("patchy4", "uniform4")], ignore_index=True)
-        return mann_whitney_part(ctx, both.drop(columns="condition").rename(columns={"layout": "condition"}), measure,
-                             "condition", "patchy4", "uniform4", sign)
-
-    def sweep(value: str) -> Outcome:
-        return spearman_part(ctx, _npatch(ctx), "n", value, +1)
-    stat = "median episode {} patchy4 minus uniform4; Mann-Whitney"
-    return [ctx.part("food, patchy vs uniform", stat.format("food_total"), functools.partial(layouts, "food_total",
-                                                                                               +1)),
-            ctx.part("Theil, patchy vs uniform (n.s.)", stat.format("theil_t"), functools.partial(layouts, "theil_t",
-                                                                                                    0)),
-            ctx.part("iso/free food vs n", "Spearman rho of iso food / mean free food at n against n patches",
-                     functools.partial(sweep, "food_ratio")),
-            ctx.part("iso Theil vs n", "Spearman rho of iso-series Theil T against n patches",
-                     functools.partial(sweep, "theil_t"))]
-
-
 # --------------------------------------------------------------- Fig 5
 ONEPATCH_FOOD = analysis_table("behaviour", "onepatch", "food_per_agent")
-ROLE_TESTS = analysis_table("onepatch", "onepatch", "role_tests")
 
 
 @claim("C14", "5E-H", "intruder B eats more with A present than alone; A is unaffected; B does better when larger",
-       [ONEPATCH_FOOD, ROLE_TESTS])
+       [ONEPATCH_FOOD])
 def c14(ctx: Context) -> list[Part]:
-    def social(role: str, group: str, sign: int) -> Outcome:
-        """The onepatch analysis's Mann-Whitney row of ``role``; interval over its food_per_agent episodes."""
-        row = stat_row(ctx.table(ROLE_TESTS), role=role, group=group)
-        food = roles(ctx.table(ONEPATCH_FOOD)).query("role == @role")
-        if group == "social":  # A's social conditions are pooled
-            food = food.assign(setting=np.where(food["setting"] == "alone", "alone", "social"))
-        food = food[food["setting"].isin([group, "alone"])]
-        return from_row(row, sign, ctx.ci(food, median_diff("food_eaten", "setting", group, "alone"), strata="setting"))
+    def people() -> pd.DataFrame:
+        """Agent-episodes with role (A, B), setting (a social condition or alone) and the size class they match."""
+        return roles(ctx.table(ONEPATCH_FOOD))
+
+    def b_social(size_class: str) -> Outcome:
+        """B with A in ``size_class`` vs B alone at the same size (the matched alone condition)."""
+        b = people().query("role == 'B' and size_class == @size_class")
+        return mann_whitney_part(ctx, b, "food_eaten", "setting", size_class, "alone", +1)
+
+    def a_unaffected() -> Outcome:
+        """A with B (every size class) vs A alone at the same sizes: the two samples have one size mix."""
+        a = people().query("role == 'A'")
+        a = a.assign(setting=np.where(a["setting"] == "alone", "alone", "social"))
+        return unpaired_equivalence(ctx, a, "food_eaten", "setting", "social", "alone")
 
     def b_size() -> Outcome:
-        b = roles(ctx.table(ONEPATCH_FOOD)).query("role == 'B' and setting != 'alone'")
-        return spearman_part(ctx, b[b["setting"].isin(SOCIAL)], "size", "food_eaten", +1)
-    stat = "median food of B with A ({}) minus B alone; Mann-Whitney (onepatch role_tests)"
-    return ([ctx.part(f"B social, {c}", stat.format(c), functools.partial(social, "B", c, +1)) for c in SOCIAL]
-            + [ctx.part("A social vs alone (n.s.)", "median food of A with B minus A alone; Mann-Whitney (onepatch "
-                        "role_tests)", functools.partial(social, "A", "social", 0)),
+        b = people().query("role == 'B' and setting != 'alone'")
+        return spearman_part(ctx, b, "size", "food_eaten", +1)
+    stat = "median food of B with A ({}) minus B alone at B's size; Mann-Whitney"
+    return ([ctx.part(f"B social, {c}", stat.format(c), functools.partial(b_social, c)) for c in SOCIAL]
+            + [ctx.part("A social vs alone (equivalent)", "median food of A with B minus A alone at A's sizes "
+                        "(size classes pooled, one alone condition per class); Mann-Whitney and TOST", a_unaffected),
                ctx.part("B food vs B size", "Spearman rho of B's food against B's size over the social conditions",
                         b_size)])
 
@@ -442,26 +362,21 @@ SQUARE2_STEPS = rollout_table("square2", "steps")
 
 
 def _confronting(ctx: Context) -> Outcome:
-    """Bite rate of confronting pair-steps minus the next-highest class, Fisher exact, interval over episodes."""
+    """Per-episode bite rate of confronting pair-steps minus the next-highest class, paired Wilcoxon over episodes."""
     a, steps = ctx.cfg.analysis, ctx.table(SQUARE2_STEPS)
-    # bite_rate_by_class sums over a condition; each episode as its own condition gives per-episode counts
+    # bite_rate_by_class sums over a condition; each episode as its own condition gives per-episode rates
     per = bite_rate_by_class(steps.assign(condition=steps["episode"]), a.bout_cm, a.facing_rad, a.away_rad)
-    per = per.rename(columns={"condition": "episode"}).dropna(subset=["label"])
+    per = per.rename(columns={"condition": "episode"}).dropna(subset=["label", "rate"])
     per = per[per["label"] != "undefined"]
-    total = per.groupby("label")[["bites", "n_steps"]].sum()
-    total = total[total["n_steps"] > 0]
-    if "confronting" not in total.index or len(total) < 2:
+    pooled = per.groupby("label")[["bites", "n_steps"]].sum()
+    if "confronting" not in pooled.index or len(pooled) < 2:
         raise ValueError("no confronting pair-step, or no other class, within range")
-    rates = total["bites"] / total["n_steps"]
-    other = rates.drop("confronting").idxmax()
-    diff, p = fisher_rates(*total.loc["confronting"].astype(int), *total.loc[other].astype(int))
-
-    def stat(d: pd.DataFrame) -> float:
-        s = d.groupby("label")[["bites", "n_steps"]].sum()
-        r = s["bites"] / s["n_steps"].where(s["n_steps"] > 0)
-        return float(r.get("confronting", np.nan) - r.get(other, np.nan))
-    return Outcome(diff, p, int(total["n_steps"].sum()), +1, ctx.ci(per, stat, strata=None),
-                   f"next-highest class: {other}")
+    other = (pooled["bites"] / pooled["n_steps"]).drop("confronting").idxmax()
+    # episodes where both classes occur within range: each episode is one paired unit (rule 1)
+    both = per[per["label"].isin(["confronting", other])]
+    both = both[both.groupby("episode")["label"].transform("nunique") == 2]
+    out = paired_difference(ctx, both, "confronting", other, value="rate", key="label", unit="episode")
+    return dataclasses.replace(out, reason="; ".join(r for r in (out.reason, f"next-highest class: {other}") if r))
 
 
 @claim("C16", "5K-P", "larger agents chase; biting peaks early in bouts; confronting bouts bite most",
@@ -474,8 +389,9 @@ def c16(ctx: Context) -> list[Part]:
     return [ctx.part("chaser larger", "median chaser minus chased size over chasing bouts (square2); Wilcoxon",
                      functools.partial(_size_roles, ctx, "square2", "chase", "chase_sizes")),
             ctx.part("bites early", "median normalised bite time in its bout minus 0.5; Wilcoxon", timing),
-            ctx.part("confronting bites most", "bite rate per pair-step within range, confronting minus the "
-                     "next-highest class; Fisher exact", functools.partial(_confronting, ctx))]
+            ctx.part("confronting bites most", "median over episodes of the bite rate per pair-step within range, "
+                     "confronting minus the next-highest class; Wilcoxon signed-rank", functools.partial(_confronting,
+                                                                                                       ctx))]
 
 
 # --------------------------------------------------------------- Fig 6
@@ -492,17 +408,32 @@ def c17(ctx: Context) -> list[Part]:
         dims = dims.assign(fraction=dims["d_eff"] / width).dropna(subset=["fraction"])
         return one_sample_part(ctx, dims, "fraction", a.claims_deff_fraction, -1)
 
-    def grows(knollen: str, sign: int) -> Outcome:
-        """The dynamics analysis's Spearman row (size_tests); interval over its dimensionality episodes."""
-        row = stat_row(ctx.table(GROUPSIZE_TESTS), group=knollen)
+    def per_episode() -> pd.DataFrame:
+        """D_eff averaged over the agents of each groupsize episode (rule 1: the episode is the unit)."""
         dims = groupsize_parts(ctx.table(analysis_table("dynamics", "groupsize", "dimensionality")))
-        return from_row(row, sign, ctx.ci(dims[dims["knollenorgans"] == knollen], rho_of("n_agents", "d_eff")))
+        return (dims.groupby(["condition", "episode", "n_agents", "knollenorgans"], as_index=False)["d_eff"].mean()
+                .dropna(subset=["d_eff"]))
+
+    def grows() -> Outcome:
+        return spearman_part(ctx, per_episode().query("knollenorgans == 'K'"), "n_agents", "d_eff", +1)
+
+    def interaction() -> Outcome:
+        d = per_episode()
+        on = (d["knollenorgans"] == "K").to_numpy(np.float64)
+        b, p, n = interaction_slope(d["n_agents"], d["d_eff"], on)
+
+        def stat(s: pd.DataFrame) -> float:
+            try:
+                return interaction_slope(s["n_agents"], s["d_eff"], (s["knollenorgans"] == "K").to_numpy(float))[0]
+            except ValueError:
+                return np.nan
+        return Outcome(b, p, n, +1, ctx.ci(d, stat))
     return [ctx.part("low-dimensional", f"median D_eff / width ({width}) minus {a.claims_deff_fraction} (patchy4); "
                      "Wilcoxon", low),
-            ctx.part("D_eff grows with N, K on", "Spearman rho(D_eff, N) over agent-episodes, Knollenorgans on "
-                     "(dynamics size_tests)", functools.partial(grows, "K", +1)),
-            ctx.part("K off (n.s.)", "Spearman rho(D_eff, N) over agent-episodes, Knollenorgans off (dynamics "
-                     "size_tests)", functools.partial(grows, "noK", 0))]
+            ctx.part("D_eff grows with N, K on", "Spearman rho(mean D_eff of the episode, N), Knollenorgans on "
+                     "(groupsize)", grows),
+            ctx.part("growth larger with K than without", "OLS slope of episode D_eff on N with Knollenorgans on "
+                     "minus off (the N x K interaction of D_eff ~ N * K over episodes); t-test", interaction)]
 
 
 @claim("C18", "6D", "the Knollenorgan error angle is decoded better than the straight bearing to the target",
@@ -516,12 +447,20 @@ def c18(ctx: Context) -> list[Part]:
         skills = heldout_skill(j[h].to_numpy(), {"err_knollen_rad": (j["err_knollen_rad"].to_numpy(), True),
                                                  "bearing_agent_rad": (j["bearing_agent_rad"].to_numpy(), True)},
                                j["episode"].to_numpy(), ctx.cfg.analysis.decode_folds)
-        return paired_skill(ctx, skills, "err_knollen_rad", "bearing_agent_rad")
+        out = paired_difference(ctx, skills, "err_knollen_rad", "bearing_agent_rad")
+        # faithful to the paper, and partly mechanical: the binarised Knollenorgan signs encode the target field's
+        # direction relative to the body, while the straight bearing is not observed
+        note = "partly by construction: the Knollenorgan signs encode the field direction, the bearing is unobserved"
+        return dataclasses.replace(out, reason="; ".join(r for r in (out.reason, note) if r))
     return [ctx.part("err vs bearing", "median over episodes of held-out decoding skill (1 - MSE / MSE of the "
                      "train mean) of err_knollen minus bearing to the target; Wilcoxon", compute)]
 
 
-AGENT_FEATURES = ("dist_agent_cm", "n_knollen_agents")  # nearest-agent distance and the Knollenorgan feature
+#: Fig 6E's sensed variables (CLAIMS rule 7: never the policy's own outputs or the agent's constant size), and
+#: among them the agent and Knollenorgan features the paper finds best.
+SENSED = {"dist_agent_cm": False, "knollen_spikes": False, "n_agents_100cm": False, "log_morm_sensed": False,
+          "dist_wall_cm": False}
+AGENT_FEATURES = ("dist_agent_cm", "knollen_spikes", "n_agents_100cm")
 FOOD_FEATURES = ("dist_food_cm", "bearing_food_rad")
 
 
@@ -529,36 +468,41 @@ FOOD_FEATURES = ("dist_food_cm", "bearing_food_rad")
        "when food is in range", [WIDE2_HIDDEN, WIDE2_STEPS])
 def c19(ctx: Context) -> list[Part]:
     folds = ctx.cfg.analysis.decode_folds
+    near_cm = ctx.cfg.analysis.claims_food_near_cm
 
     def ranking() -> Outcome:
-        j, h = joined(ctx, WIDE2_HIDDEN, WIDE2_STEPS, [c for c in DECODE_TARGETS
-                                                       if c in ctx.table(WIDE2_STEPS).columns])
-        targets = [c for c in DECODE_TARGETS if c in j.columns and j[c].notna().mean() > 0.5]
-        j = j.dropna(subset=targets)
-        skills = heldout_skill(j[h].to_numpy(), {c: (j[c].to_numpy(), DECODE_TARGETS[c]) for c in targets},
+        missing = [c for c in SENSED if c not in ctx.table(WIDE2_STEPS).columns]
+        if missing:
+            raise ValueError(f"the wide2 steps table lacks the sensed variables {missing}: rerun the assay")
+        j, h = joined(ctx, WIDE2_HIDDEN, WIDE2_STEPS, list(SENSED))
+        # a step where no Mormyromast reads above E_min is recorded as NaN; the channel then delivers its floor
+        # (every normalised reading 0), so it is decoded as log10 E_min there: every variable on the same steps
+        j["log_morm_sensed"] = j["log_morm_sensed"].fillna(np.log10(ctx.cfg.sensors.mormyromast.e_min))
+        j = j[np.isfinite(j[list(SENSED)].astype(np.float64)).all(axis=1)]
+        skills = heldout_skill(j[h].to_numpy(), {c: (j[c].to_numpy(), SENSED[c]) for c in SENSED},
                                j["episode"].to_numpy(), folds)
         mean = skills.groupby("target")["skill"].mean()
         ours, rest = mean.reindex(AGENT_FEATURES).dropna(), mean.drop(list(AGENT_FEATURES), errors="ignore")
         if ours.empty or rest.empty:
-            raise ValueError("no agent or no other decoding target with finite skill")
-        out = paired_skill(ctx, skills, ours.idxmax(), rest.idxmax())
-        return Outcome(**{**out.__dict__, "reason": out.reason or f"best {ours.idxmax()} vs best other "
-                                                                  f"{rest.idxmax()}"})
+            raise ValueError("no agent or no other sensed variable with a finite decoding skill")
+        out = paired_difference(ctx, skills, ours.idxmax(), rest.idxmax())
+        ranked = ", ".join(f"{k} {v:.2f}" for k, v in mean.sort_values(ascending=False).items())
+        return dataclasses.replace(out, reason="; ".join(r for r in (out.reason, f"mean skill: {ranked}") if r))
 
     def food() -> Outcome:
         j, h = joined(ctx, WIDE2_HIDDEN, WIDE2_STEPS, list(FOOD_FEATURES))
         j = j.dropna(subset=list(FOOD_FEATURES))
         parts = []
-        for name, sub in (("near", j[j["dist_food_cm"] <= ctx.cfg.analysis.claims_food_near_cm]),
-                          ("far", j[j["dist_food_cm"] > ctx.cfg.analysis.claims_food_near_cm])):
+        for name, sub in (("near", j[j["dist_food_cm"] <= near_cm]), ("far", j[j["dist_food_cm"] > near_cm])):
             s = heldout_skill(sub[h].to_numpy(), {c: (sub[c].to_numpy(), DECODE_TARGETS[c]) for c in FOOD_FEATURES},
                               sub["episode"].to_numpy(), folds)
             parts.append(s.groupby("group", as_index=False)["skill"].mean().assign(target=name))
-        return paired_skill(ctx, pd.concat(parts, ignore_index=True), "near", "far")
-    return [ctx.part("agent features best", "median over episodes of held-out skill of the best agent feature "
-                     "minus the best other target (wide2); Wilcoxon", ranking),
-            ctx.part("food near > far", "median over episodes of held-out skill of food distance and bearing, "
-                     "food in range minus out of range; Wilcoxon", food)]
+        return paired_difference(ctx, pd.concat(parts, ignore_index=True), "near", "far")
+    return [ctx.part("agent features best", "median over episodes of held-out skill of the best agent or "
+                     "Knollenorgan feature minus the best other sensed variable (wide2; turn, EOD, bite and size "
+                     "excluded); Wilcoxon", ranking),
+            ctx.part("food near > far", f"median over episodes of held-out skill of food distance and bearing, "
+                     f"nearest pellet within {near_cm:g} cm minus beyond; Wilcoxon", food)]
 
 
 WIDE2_PLSC = analysis_table("dynamics", "wide2", "plsc")
@@ -670,3 +614,8 @@ def claims_table(results: str | Path, cfg: EfishConfig, claims: Iterable[str] | 
     tables = read_claim_tables(results, {t for c in chosen for t in CLAIMS[c].tables})
     rows = [CLAIMS[c].run({t: tables[t] for t in CLAIMS[c].tables if t in tables}, cfg) for c in chosen]
     return pd.DataFrame(rows, columns=ROW_COLUMNS).astype({"n": "int64"})
+
+
+# claims_fig4 registered C10-C13 on import, before this module's claims: list them in the paper's order
+for _cid, _claim in sorted(CLAIMS.items(), key=lambda item: int(item[0][1:])):
+    CLAIMS[_cid] = CLAIMS.pop(_cid)

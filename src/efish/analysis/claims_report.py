@@ -27,11 +27,15 @@ def _effects(table: pd.DataFrame) -> list[str]:
 
 def claims_markdown(table: pd.DataFrame, header: str) -> str:
     """The claims table as markdown under a ``header`` line: claim, panel, statistic, effect [95% CI], n, p, verdict,
+    seeds_agree (when the table has it: the verdicts across the top seeds, :mod:`efish.analysis.claims_seeds`),
     reason (what the README quotes and the Snakemake report shows)."""
     shown = pd.DataFrame({
         "claim": table["claim"], "panel": table["panel"], "statistic": table["statistic"],
         "effect [95% CI]": _effects(table), "n": table["n"], "p": [_num(p) for p in table["p"]],
-        "verdict": table["verdict"], "reason": table["reason"]})
+        "verdict": table["verdict"]})
+    if "seeds_agree" in table.columns:
+        shown["seeds_agree"] = table["seeds_agree"]
+    shown["reason"] = table["reason"]
     counts = table["verdict"].value_counts()
     summary = ", ".join(f"{counts[v]} {v}" for v in VERDICTS if v in counts)
     return f"{header}\n\n{summary}.\n\n{markdown_table(shown)}"
@@ -54,11 +58,13 @@ def load_claims(where: str | Path, results_root: str | Path = "results") -> tupl
 
 
 def compare_claims(a: pd.DataFrame, b: pd.DataFrame, names: tuple[str, str] = ("A", "B")) -> pd.DataFrame:
-    """Two claims tables side by side, one row per claim: each run's verdict and effect [95% CI], and whether the
-    verdict moved. A claim only one table has shows '-' on the other side."""
+    """Two claims tables side by side, one row per claim: each run's verdict, seeds_agree (the verdicts across its
+    top seeds; '-' for a run whose table has no such column), effect [95% CI] and n, and whether the verdict moved.
+    A claim only one table has shows '-' on the other side."""
     def side(t: pd.DataFrame, name: str) -> pd.DataFrame:
+        agree = t["seeds_agree"] if "seeds_agree" in t.columns else "-"
         return pd.DataFrame({"claim": t["claim"], "panel": t["panel"], f"{name} verdict": t["verdict"],
-                             f"{name} effect [95% CI]": _effects(t), f"{name} n": t["n"]})
+                             f"{name} seeds_agree": agree, f"{name} effect [95% CI]": _effects(t), f"{name} n": t["n"]})
 
     if names[0] == names[1]:
         names = (f"{names[0]} (A)", f"{names[1]} (B)")

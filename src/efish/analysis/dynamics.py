@@ -21,14 +21,24 @@ from sklearn.model_selection import GroupKFold, cross_val_predict
 from ._tables import AGENT_EPISODE, DEFAULTS, EPISODE, RATE_HZ, nan_frame, require
 
 SUBSAMPLE_FRACTIONS = tuple(DEFAULTS.subsample_fractions)
-#: Steps columns decoded from the hidden state (SPEC 12 "Decoding", Fig 6D-F) -> circular (radians) or not. The
-#: last ones are the paper's decoding targets the rollout records from issue 13 on; a column the steps table
-#: lacks gets a row with a reason.
-DECODE_TARGETS = {"dist_agent_cm": False, "bearing_agent_rad": True, "dist_food_cm": False, "bearing_food_rad": True,
-                  "dist_wall_cm": False, "bearing_wall_rad": True, "size": False, "eod": False,
-                  "dist_agent2_cm": False, "size_agent1": False, "size_agent2": False, "n_knollen_agents": False,
-                  "food_count_5cm": False, "turn_rad": False, "log_morm_field": False, "log_amp_field": False}
-DECODE_COLUMNS = ["condition", "target", "circular", "r2", "baseline_r2", "score", "n", "n_groups", "folds", "reason"]
+#: Steps columns of the world the hidden state has observed (SPEC "Decoding variables (revised)", Fig 6E's sensed
+#: variables) -> circular (radians) or not: the only competitors when decoding scores are ranked (claim C19).
+#: Each describes the world after step t, which the hidden row t has taken in (efish.rollout.run.hidden_table).
+SENSED_TARGETS = {"dist_agent_cm": False, "n_agents_100cm": False, "log_morm_sensed": False, "dist_wall_cm": False,
+                  "bearing_agent_rad": True, "dist_agent2_cm": False, "size_agent1": False, "size_agent2": False,
+                  "dist_food_cm": False, "bearing_food_rad": True, "bearing_wall_rad": True,
+                  "food_count_5cm": False, "log_amp_field": False}
+#: Steps columns that are readouts of the policy itself, not sensing (CLAIMS rule 7): its own outputs of step t
+#: (the realised turn, the EOD: produced by the state before row t's, and fed back to row t's state through the
+#: observation's last-action tail) and the agent's own size, a per-agent constant of every observation. Decoded and
+#: reported, never ranked among the sensed targets.
+READOUT_TARGETS = {"turn_rad": False, "eod": False, "size": False}
+#: Every decoded steps column -> circular: the sensed targets, then the readouts. A column the steps table lacks
+#: gets a row with a reason. Kept as the union so that the decoding table has a row for each.
+DECODE_TARGETS = {**SENSED_TARGETS, **READOUT_TARGETS}
+#: ``readout``: the row's target is in :data:`READOUT_TARGETS` (drawn and reported apart from the sensed ones).
+DECODE_COLUMNS = ["condition", "target", "circular", "readout", "r2", "baseline_r2", "score", "n", "n_groups", "folds",
+                  "reason"]
 
 
 def units(hidden: pd.DataFrame) -> list[str]:
@@ -273,7 +283,8 @@ def decode_table(hidden: pd.DataFrame, steps: pd.DataFrame, targets: dict[str, b
     All agents of a condition are pooled and folds are grouped by episode.
     ``targets`` maps a steps column to whether it is circular (default
     :data:`DECODE_TARGETS`). One row per condition and target (columns
-    :data:`DECODE_COLUMNS`); a target the steps table lacks is NaN with a reason.
+    :data:`DECODE_COLUMNS`, ``readout`` True for the targets of
+    :data:`READOUT_TARGETS`); a target the steps table lacks is NaN with a reason.
     """
     targets = DECODE_TARGETS if targets is None else targets
     present = [c for c in targets if c in steps.columns]
@@ -284,7 +295,8 @@ def decode_table(hidden: pd.DataFrame, steps: pd.DataFrame, targets: dict[str, b
         for target, circular in targets.items():
             res = (decode(x, sub[target].to_numpy(np.float64), sub["episode"].to_numpy(), circular, folds)
                    if target in present else {"reason": f"steps table lacks column {target!r}"})
-            rows.append({"condition": cond, "target": target, "circular": circular, **res})
+            rows.append({"condition": cond, "target": target, "circular": circular,
+                         "readout": target in READOUT_TARGETS, **res})
     if not rows:
         return nan_frame("no hidden row matches a step").reindex(columns=DECODE_COLUMNS)
     return pd.DataFrame(rows, columns=DECODE_COLUMNS)
@@ -295,10 +307,14 @@ FOOD_TARGETS = {"dist_food_cm": False, "bearing_food_rad": True}
 FOOD_DECODE_COLUMNS = ["condition", "food", *DECODE_COLUMNS[1:]]
 
 
-def food_decode_table(hidden: pd.DataFrame, steps: pd.DataFrame, near_cm: float,
+def food_decode_table(hidden: pd.DataFrame, steps: pd.DataFrame, near_cm: float = DEFAULTS.claims_food_near_cm,
                       folds: int = DEFAULTS.decode_folds) -> pd.DataFrame:
     """:func:`decode_table` of the food variables on the steps with the nearest food within ``near_cm`` (``food``
     = "near": in receptor range) and on those beyond it ("far"), per condition (Fig 6F, claim C19).
+
+    ``near_cm``: ``analysis.claims_food_near_cm`` (the analysis passes the
+    configured value; the default is its default, the authors' 5 cm
+    Mormyromast food range).
 
     Steps without food (NaN distance) are in neither. One row per range,
     condition and food target (columns :data:`FOOD_DECODE_COLUMNS`); a range

@@ -1,10 +1,14 @@
 """The one-patch intruder and bot assays (SPEC 11; Fig 5E-J): who is A and who is B, and the tests by role.
 
 Roles follow ``config/assay/onepatch.yaml``: in the social conditions agent 0
-is the resident A (at the patch) and agent 1 the intruder B; in ``A_alone``
-and ``B_alone`` the single agent (0) is the letter the condition names. In
-``config/assay/bot.yaml`` the bot is agent 0 and the trained agent B is agent
-1; a bot condition's name ends in ``rate<EOD rate>_<frozen|moving>``.
+is the resident A (at the patch) and agent 1 the intruder B; in an alone
+condition (``A_alone_<s>``, ``B_alone_<s>``, ``s`` = 100 x the lone agent's
+size) the single agent (0) is the letter the condition names. The alone
+controls are matched by size (claim C14): each social condition (size class)
+has, per role, the alone condition at the size that role has in it
+(:data:`MATCHED_ALONE`), so that "B with A" and "B alone" compare one size.
+In ``config/assay/bot.yaml`` the bot is agent 0 and the trained agent B is
+agent 1; a bot condition's name ends in ``rate<EOD rate>_<frozen|moving>``.
 
 :func:`role_tests` and :func:`reach_tests` are the statistic tables of the
 ``onepatch`` analysis (columns of :data:`efish.analysis.stats.STAT_COLUMNS`
@@ -21,10 +25,17 @@ import pandas as pd
 from ._tables import AGENT_EPISODE, require
 from .stats import fisher_row, mann_whitney, nan_stat_row
 
-#: The lone-agent conditions and the role their agent plays.
-ALONE = {"A_alone": "A", "B_alone": "B"}
-#: The social conditions, B's size rising (A > B, A = B, A < B).
-SOCIAL = ("A_gt_B", "A_eq_B", "A_lt_B")
+#: The social conditions (size classes), B's size rising, and the sizes (A, B) each sets (``env.sizes``).
+SOCIAL_SIZES = {"A_gt_B": (0.75, 0.25), "A_eq_B": (0.5, 0.5), "A_lt_B": (0.25, 0.75)}
+SOCIAL = tuple(SOCIAL_SIZES)
+#: The lone-agent conditions: condition -> (the role its agent plays, the agent's size).
+ALONE = {"A_alone_25": ("A", 0.25), "A_alone_50": ("A", 0.5), "A_alone_75": ("A", 0.75),
+         "B_alone_25": ("B", 0.25), "B_alone_50": ("B", 0.5), "B_alone_75": ("B", 0.75)}
+#: (role, social condition) -> the alone condition at the size that role has in the social condition.
+MATCHED_ALONE = {("A", "A_gt_B"): "A_alone_75", ("A", "A_eq_B"): "A_alone_50", ("A", "A_lt_B"): "A_alone_25",
+                 ("B", "A_gt_B"): "B_alone_25", ("B", "A_eq_B"): "B_alone_50", ("B", "A_lt_B"): "B_alone_75"}
+#: Alone condition -> the size class (social condition) it is the control of.
+ALONE_CLASS = {alone: social for (_, social), alone in MATCHED_ALONE.items()}
 RESIDENT = 0  # agent index of A in a social condition
 #: The trained agent B of the bot assay (the bot is agent 0).
 BOT_TRAINED = 1
@@ -41,24 +52,30 @@ def food_from_steps(steps: pd.DataFrame) -> pd.DataFrame:
 
 
 def roles(food: pd.DataFrame) -> pd.DataFrame:
-    """Rows of the one-patch conditions with ``role`` (A or B) and ``setting`` (the social condition or ``alone``).
+    """Rows of the one-patch conditions with ``role`` (A or B), ``setting`` (the social condition or ``alone``) and
+    ``size_class`` (the social condition; for an alone row, the social condition it is matched to by size).
 
-    Rows of other conditions are dropped (the bot assay has none).
+    B in A_lt_B and B alone at 0.75 share ``size_class`` A_lt_B. Rows of other conditions are dropped (the bot
+    assay has none).
     """
     require(food, ["condition", "agent"], "table")
     food = food[food["condition"].isin([*SOCIAL, *ALONE])]
     alone = food["condition"].isin(list(ALONE)).to_numpy()
-    role = np.where(alone, food["condition"].map(ALONE), np.where(food["agent"] == RESIDENT, "A", "B"))
-    return food.assign(role=role, setting=np.where(alone, "alone", food["condition"]))
+    lone_role = food["condition"].map({c: r for c, (r, _) in ALONE.items()})
+    role = np.where(alone, lone_role, np.where(food["agent"] == RESIDENT, "A", "B"))
+    size_class = np.where(alone, food["condition"].map(ALONE_CLASS), food["condition"])
+    return food.assign(role=role, setting=np.where(alone, "alone", food["condition"]), size_class=size_class)
 
 
 def role_tests(food: pd.DataFrame) -> pd.DataFrame:
-    """Mann-Whitney of B's food in each social condition vs B alone, and of A's food (social pooled) vs A alone.
+    """Mann-Whitney of each role's food in each social condition vs that role alone at the same size.
 
     ``food``: one row per agent-episode with ``food_eaten`` (:func:`food_from_steps`).
-    Rows: ``role`` B, group = the social condition; ``role`` A, group ``social``;
-    control ``alone``; effect = median difference. A role without its alone
-    condition or without a social condition is one NaN row that says so.
+    Rows: per ``role`` (B, then A) and social condition (:data:`SOCIAL`):
+    group = the social condition, control = the matched alone condition
+    (:data:`MATCHED_ALONE`, e.g. B in A_lt_B vs ``B_alone_75``); effect =
+    median difference (social minus alone), two-sided. A pair without
+    episodes of either side is one NaN row that says so.
     """
     require(food, ["condition", "agent", "food_eaten"], "food table")
     people = roles(food)
@@ -67,14 +84,14 @@ def role_tests(food: pd.DataFrame) -> pd.DataFrame:
     out = []
     for role in ("B", "A"):
         mine = people[people["role"] == role]
-        if role == "A":
-            mine = mine.assign(setting=np.where(mine["setting"] == "alone", "alone", "social"))
-        settings = set(mine["setting"])
-        if "alone" not in settings or settings == {"alone"}:
-            what = f"{role}_alone" if "alone" not in settings else "a social condition"
-            out.append(nan_stat_row(f"no {what} episode with {role}'s food", role=role))
-            continue
-        out.append(mann_whitney(mine, "food_eaten", "setting", "alone").assign(role=role))
+        for social in SOCIAL:
+            alone = MATCHED_ALONE[role, social]
+            pair = mine[mine["size_class"] == social]
+            if lacking := [c for c in (social, alone) if c not in set(pair["condition"])]:
+                out.append(nan_stat_row(f"no {' or '.join(lacking)} episode with {role}'s food", role=role,
+                                        group=social, control=alone))
+                continue
+            out.append(mann_whitney(pair, "food_eaten", "condition", alone).assign(role=role))
     return pd.concat(out, ignore_index=True)
 
 

@@ -53,6 +53,7 @@ from .signalling import (
     load_real_idis,
     peri_event_rate,
     rate_advantage_vs_size,
+    xmin_in_steps,
 )
 from .stats import STAT_COLUMNS, dunnett_by_measure, spearman
 
@@ -103,25 +104,35 @@ def _homer(cfg: EfishConfig) -> int | None:
 
 # ------------------------------------------------------------- signalling
 def _idi_samples(ids: pd.DataFrame, conditions: Iterable, cfg: EfishConfig) -> dict[tuple, np.ndarray | str]:
-    """IDIs (ms) per (source, condition): the agents' per condition and the real fish's, or why there are none."""
-    samples = {("agents", c): ids.loc[ids["condition"] == c, "idi_ms"].to_numpy() for c in sorted(conditions)}
+    """IDIs per (source, condition): the agents' in whole steps, the real fish's in ms, or why there are none."""
+    samples = {("agents", c): ids.loc[ids["condition"] == c, "idi_steps"].to_numpy() for c in sorted(conditions)}
     real = load_real_idis(cfg.analysis.real_fish_idis)
     samples["real_fish", np.nan] = real["reason"].iloc[0] or real["idi_ms"].to_numpy()
     return samples
 
 
 def _idi_tables(ids: pd.DataFrame, conditions: Iterable, cfg: EfishConfig) -> Tables:
-    """IDI histograms and power-law fits per source and condition (Fig 3C,D; supplement)."""
+    """IDI histograms and power-law fits per source and condition (Fig 3C,D; supplement).
+
+    The agents' IDIs are whole steps and are fitted as a discrete power law from
+    ``analysis.xmin_ms`` rounded up to steps (as the authors fit them); the real
+    fish's are fitted continuously in ms. ``xmin`` is in ms in both rows.
+    """
     a, hist, fits = cfg.analysis, [], []
+    step_ms = 1000.0 / cfg.env.fps
     for (source, cond), x in _idi_samples(ids, conditions, cfg).items():
         keys = {"source": source, "condition": cond}
+        discrete = source == "agents"
+        xmin = xmin_in_steps(a.xmin_ms, step_ms) if discrete else a.xmin_ms
+        scale = step_ms if discrete else 1.0
+        extra = {"discrete": discrete, "xmin_steps": float(xmin) if discrete else np.nan}
         if isinstance(x, str):  # no sample: say why
             hist.append(nan_frame(x, **keys))
-            fits.append({**keys, **fit_power_law([], a.xmin_ms), "reason": x})
+            fits.append({**keys, **fit_power_law([], xmin), **extra, "xmin": xmin * scale, "reason": x})
             continue
-        h = idi_histogram(x, a.idi_bins, a.idi_lo_ms, a.idi_hi_ms)
+        h = idi_histogram(np.asarray(x, np.float64) * scale, a.idi_bins, a.idi_lo_ms, a.idi_hi_ms)
         hist.append(h.assign(**keys, reason="" if h["count"].sum() else "no IDI in the histogram range"))
-        fits.append({**keys, **fit_power_law(x, a.xmin_ms)})
+        fits.append({**keys, **fit_power_law(x, xmin, discrete=discrete), **extra, "xmin": xmin * scale})
     return {"idi_histogram": pd.concat(hist, ignore_index=True), "power_law": pd.DataFrame(fits)}
 
 

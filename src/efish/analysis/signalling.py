@@ -60,40 +60,47 @@ def idi_histogram(idi_ms, bins: int = DEFAULTS.idi_bins, lo_ms: float = DEFAULTS
     return pd.DataFrame({"bin_lo_ms": edges[:-1], "bin_hi_ms": edges[1:], "count": counts, "density": density})
 
 
-def fit_power_law(idi_ms, xmin_ms: float = DEFAULTS.xmin_ms, min_n: int = 10) -> dict:
-    """Power-law fit of IDIs >= ``xmin_ms`` with ``powerlaw.Fit``, compared with lognormal and exponential.
+def fit_power_law(idi, xmin: float = DEFAULTS.xmin_ms, min_n: int = 10, discrete: bool = False) -> dict:
+    """Power-law fit of IDIs >= ``xmin`` with ``powerlaw.Fit``, compared with lognormal and exponential.
 
-    Returns ``alpha``, ``xmin``, ``n`` (IDIs in the fit), and for each
-    alternative the normalised loglikelihood ratio ``R_<alt>`` (> 0 favours the
-    power law) and its ``p``. ``reason`` is empty for a clean fit; it names why
-    the numbers are NaN (fewer than ``min_n`` IDIs, no spread), or lists
+    ``discrete``: the IDIs are whole steps (the agents': an EOD is emitted on a
+    step, so most IDIs are 1-3 steps) and are fitted as a discrete power law, as
+    the authors do; ``xmin`` is then in steps. Otherwise (real fish, ms) the fit
+    is continuous. Returns ``alpha``, ``xmin``, ``n`` (IDIs in the fit), and for
+    each alternative the normalised loglikelihood ratio ``R_<alt>`` (> 0 favours
+    the power law) and its ``p``. ``reason`` is empty for a clean fit; it names
+    why the numbers are NaN (fewer than ``min_n`` IDIs, no spread), or lists
     powerlaw's warnings, e.g. an alternative whose maximum-likelihood fit did
     not converge (its R is kept: it compares with the best fit powerlaw found).
     """
-    x = np.asarray(idi_ms, dtype=np.float64)
+    x = np.asarray(idi, dtype=np.float64)
     x = x[np.isfinite(x) & (x > 0)]  # powerlaw would drop (and warn about) non-positive values itself
-    n = int(np.sum(x >= xmin_ms))
-    out = {"alpha": np.nan, "xmin": float(xmin_ms), "n": n, "R_lognormal": np.nan, "p_lognormal": np.nan,
+    n = int(np.sum(x >= xmin))
+    out = {"alpha": np.nan, "xmin": float(xmin), "n": n, "R_lognormal": np.nan, "p_lognormal": np.nan,
            "R_exponential": np.nan, "p_exponential": np.nan, "reason": ""}
     if n < min_n:
         return {**out, "reason": f"fewer than {min_n} IDIs >= xmin ({n})"}
-    if np.ptp(x[x >= xmin_ms]) == 0:
+    if np.ptp(x[x >= xmin]) == 0:
         return {**out, "reason": "all IDIs >= xmin are equal"}
     import powerlaw  # imported here: it loads matplotlib, which the rest of the analyses do not need
 
-    # powerlaw warns about the data (e.g. integer-valued IDIs fitted as continuous) and
-    # about alternatives whose optimiser did not converge (e.g. lognormal on pure
-    # power-law data, whose likelihood keeps rising as mu -> -inf); both are reported
-    # in ``reason``, not hidden and not raised.
+    # powerlaw warns about the data and about alternatives whose optimiser did not
+    # converge (e.g. lognormal on pure power-law data, whose likelihood keeps rising
+    # as mu -> -inf); both are reported in ``reason``, not hidden and not raised.
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        fit = powerlaw.Fit(x, xmin=xmin_ms, verbose=False)
+        fit = powerlaw.Fit(x, xmin=xmin, discrete=discrete, verbose=False)
         out["alpha"] = float(fit.power_law.alpha)
         for alt in ("lognormal", "exponential"):
             r, p = fit.distribution_compare("power_law", alt, normalized_ratio=True)
             out[f"R_{alt}"], out[f"p_{alt}"] = float(r), float(p)
     notes = list(dict.fromkeys(f"powerlaw: {w.message}" for w in caught))
     return {**out, "reason": "; ".join(notes)}
+
+
+def xmin_in_steps(xmin_ms: float, step_ms: float = STEP_MS) -> int:
+    """The smallest whole step count at or above ``xmin_ms`` (12 ms -> 1 step of 12.048 ms), at least 1."""
+    return max(1, int(np.ceil(xmin_ms / step_ms - 1e-9)))
 
 
 def load_real_idis(path: str | Path | None) -> pd.DataFrame:

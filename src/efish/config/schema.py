@@ -102,6 +102,9 @@ class KnollenorganConfig:
     enabled: bool = param(True, "compute and report this receptor class")
     count: int = param(12, "sensors per conspecific slot, evenly spaced", lo=1, hi=1024)
     threshold: float = param(2e-7, "|E.n| above this reads sign(E.n), V/m", lo=0.0)
+    range_cm: float = param(100.0, "conspecifics whose centre is this close are in Knollenorgan range (steps "
+                            "column n_agents_100cm, a decoding target; the authors' 100 cm); sensing is not cut "
+                            "at it, cm", lo=0.0, neutral=True)
 
 
 @dataclass
@@ -369,7 +372,14 @@ class AnalysisConfig:
                              lo=0)
     claims_alpha: float = param(0.05, "claims: a test is significant at p below this", lo=0.0, hi=1.0)
     claims_aligned_rad: float = param(math.pi / 4, "claims C2: |error| within this of 0 or pi counts as aligned, "
-                                      "rad (chance fraction 2 x this / pi)", lo=0.0, hi=math.pi / 2)
+                                      "rad", lo=0.0, hi=math.pi / 2)
+    claims_margin_fraction: float = param(0.2, "claims: equivalence margin of a 'no difference' part (TOST), as a "
+                                          "fraction of the control's median", lo=0.0)
+    claims_margin_sd: float = param(0.5, "claims: equivalence margin in pooled SDs, used where the control's median "
+                                    "is within one pooled SD of 0", lo=0.0)
+    claims_ceiling_share: float = param(0.5, "claims: a condition that ate every pellet in at least this share of "
+                                        "its episodes is at a ceiling: its food parts are not decidable", lo=0.0,
+                                        hi=1.0)
     claims_event_window: list = param([-10, 10], "claims C6: lags (steps) of the EOD rate around an event")
     claims_baseline_window: list = param([-100, -50], "claims C6: lags (steps) of the baseline rate; within "
                                          "+-peri_window")
@@ -377,8 +387,9 @@ class AnalysisConfig:
                                         lo=0.0, hi=1.0)
     claims_near_cm: float = param(10.0, "claims C21: a conspecific this close is near, cm", lo=0.0)
     claims_far_cm: float = param(100.0, "claims C21: a conspecific farther than this is far, cm", lo=0.0)
-    claims_food_near_cm: float = param(10.0, "food this close is in range when food variables are decoded near vs "
-                                       "far (dynamics food_decoding, Fig 6F, claim C19), cm", lo=0.0)
+    claims_food_near_cm: float = param(5.0, "food this close is in range when food variables are decoded near vs "
+                                       "far (dynamics food_decoding, Fig 6F, claim C19): the authors' Mormyromast "
+                                       "food range, 5 cm", lo=0.0)
 
 
 # ----------------------------------------------------------------------- scene

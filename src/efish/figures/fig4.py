@@ -5,8 +5,9 @@ Every panel reads the behaviour analysis's per-episode summary
 eod_probability, mean_nn_dist_cm, bites) and, where the analysis tests the
 conditions, its Dunnett rows (``condition_tests.parquet``, one per group and
 measure against the assay's first condition). Stars come from those rows; a
-comparison the analysis does not test (patchy vs uniform, the N-patch trends)
-is drawn without stars and its caption says so.
+comparison the analysis does not test (patchy vs uniform, the N-patch trends,
+the mute assay's 4-agent set) is drawn without stars (``n/a``) and its caption
+says so.
 """
 
 from __future__ import annotations
@@ -17,7 +18,20 @@ from collections.abc import Callable
 import pandas as pd
 
 from .panel import Panel, Tables
-from .style import CONDITION_COLOURS, box_strip, condition_order, condition_palette, mean_lines, missing, stars_for
+from .style import (
+    CONDITION_COLOURS,
+    CONTROL_COLOUR,
+    annotate_stars,
+    assay_conditions,
+    box_strip,
+    condition_order,
+    condition_palette,
+    finite,
+    mean_lines,
+    missing,
+    stars_for,
+    tint,
+)
 
 #: (y-axis label, short title) of each episode_summary measure.
 MEASURES = {
@@ -29,6 +43,15 @@ MEASURES = {
 }
 #: The N-patch assay's condition names: ``iso_<n>`` (fixed total food) and ``free_<n>`` (full food per patch).
 NPATCH_CONDITION = re.compile(r"^(iso|free)_(\d+)$")
+#: Tick labels of the collective assay's conditions (config/assay/collective.yaml); others read as plain_label.
+COLLECTIVE_LABELS = {"self_only": "self only\n(clean gate)", "self_only_authors": "self only\n(authors' mode)",
+                     "cons_only": "cons only"}
+#: Collective conditions drawn in a light tint of another's colour: the authors' self-only mode of the clean gate.
+COLLECTIVE_VARIANTS = {"self_only_authors": "self_only"}
+#: The mute assay's two designs (config/assay/mute.yaml): (unmuted, muted condition, which design it is). The
+#: first is the Results' (2 agents, uniform; the authors' code runs it) and decides claim C12; the second is the
+#: Methods' (4 agents, patchy), drawn beside it.
+MUTE_DESIGNS = (("intact", "muted", "Results, decides C12"), ("intact4", "muted4", "Methods"))
 
 
 def dunnett_stars(tests: pd.DataFrame, measure: str, groups) -> dict:
@@ -46,9 +69,17 @@ def plain_label(condition: str) -> str:
     return str(condition).replace("_", " ")
 
 
-def condition_box(assay: str, measure: str, title: str,
-                  label: Callable[[str], str] = plain_label) -> Callable[[Tables, object], None]:
-    """A draw function: ``measure`` per episode for each condition of ``assay``, Dunnett stars vs its control."""
+def collective_label(condition: str) -> str:
+    """Tick label of a collective-sensing condition (:data:`COLLECTIVE_LABELS`, else :func:`plain_label`)."""
+    return COLLECTIVE_LABELS.get(condition, plain_label(condition))
+
+
+def condition_box(assay: str, measure: str, title: str, label: Callable[[str], str] = plain_label,
+                  variants: dict[str, str] | None = None) -> Callable[[Tables, object], None]:
+    """A draw function: ``measure`` per episode for each condition of ``assay``, Dunnett stars vs its control.
+
+    ``variants`` maps a condition to another whose colour it takes, lighter (a variant of the same treatment).
+    """
     ylabel = MEASURES[measure][0]
 
     def draw(tables: Tables, ax) -> None:
@@ -61,13 +92,69 @@ def condition_box(assay: str, measure: str, title: str,
             return
         control = order[0] if control is None else control  # no test row: the config's first, as the analysis
         others = [c for c in order if c != control]
-        if box_strip(ax, summary, "condition", measure, order, condition_palette(order, control),
+        palette = condition_palette(order, control)
+        palette |= {c: tint(palette[base]) for c, base in (variants or {}).items() if c in palette and base in palette}
+        if box_strip(ax, summary, "condition", measure, order, palette,
                      stars=dunnett_stars(tests, measure, others), labels={c: label(c) for c in order}):
             ax.set_xlabel("receptors on" if label is ablation_label else "condition")
             ax.set_ylabel(ylabel)
             ax.set_title(title)
             if len(order) > 4:
                 ax.tick_params(axis="x", labelrotation=30)
+
+    return draw
+
+
+def mute_design_labels() -> tuple[list[str], dict[str, str]]:
+    """The x-axis label of each mute design (:data:`MUTE_DESIGNS`) and the tick label of each of its conditions,
+    from the conditions' configs (agents, food layout, arena size, who is muted)."""
+    configs = assay_conditions("mute")
+
+    def muted(cond: str) -> str:
+        ids = configs[cond].env.muted
+        return f"agent{'s' if len(ids) > 1 else ''} {', '.join(map(str, ids))}\nmuted" if ids else "none\nmuted"
+
+    groups = []
+    for intact, _, which in MUTE_DESIGNS:
+        cfg = configs[intact]
+        groups.append(f"{cfg.env.n_agents} agents, {cfg.arena.layout} {cfg.arena.width_cm:g}x{cfg.arena.height_cm:g}"
+                      f"\n({which})")
+    return groups, {c: muted(c) for intact, treated, _ in MUTE_DESIGNS for c in (intact, treated)}
+
+
+def mute_box(measure: str, title: str) -> Callable[[Tables, object], None]:
+    """A draw function: ``measure`` per episode in the mute assay, the two designs side by side (the Results' first),
+    each muted vs intact with the stars of a condition_tests row of exactly that pair (``n/a`` when none)."""
+    ylabel = MEASURES[measure][0]
+
+    def draw(tables: Tables, ax) -> None:
+        summary, tests = tables["summary"], tables["tests"]
+        order: list[str] = []
+        for intact, treated, _ in MUTE_DESIGNS:
+            order += [*([""] if order else []), intact, treated]
+        if not set(order) & set(summary["condition"].dropna()):
+            missing(ax, f"mute episode_summary has none of the conditions {', '.join(c for c in order if c)}")
+            return
+        palette = {"": CONTROL_COLOUR, **{c: colour for intact, treated, _ in MUTE_DESIGNS
+                                          for c, colour in ((intact, CONTROL_COLOUR), (treated, CONDITION_COLOURS[0]))}}
+        groups, labels = mute_design_labels()
+        if not box_strip(ax, summary, "condition", measure, order, palette, labels=labels):
+            return
+        values = finite(summary.loc[summary["condition"].isin(order), measure])
+        lo, hi = float(values.min()), float(values.max())
+        pad = (hi - lo) * 0.06 or max(abs(hi), 1.0) * 0.06
+        for intact, treated, _ in MUTE_DESIGNS:
+            i = order.index(intact)
+            top = finite(summary.loc[summary["condition"].isin([intact, treated]), measure])
+            annotate_stars(ax, i, (top.max() if top.size else hi) + pad,
+                           stars_for(tests, group=treated, control=intact, measure=measure), x2=i + 1)
+        ax.set_ylim(top=hi + 4 * pad)
+        # the design of each pair on a second row of x labels
+        ax.set_xticks([order.index(intact) + 0.5 for intact, _, _ in MUTE_DESIGNS], groups, minor=True)
+        ax.tick_params(axis="x", which="minor", length=0, pad=22)  # below the two-line condition labels
+        ax.set_xlabel("muting design")
+        ax.set_ylabel(ylabel)
+        ax.set_title(title)
 
     return draw
 
@@ -134,6 +221,23 @@ def _caption(what: str, assay: str, measure: str) -> str:
             f"the assay's first (control) condition, read from condition_tests (measure {measure}).")
 
 
+_COLLECTIVE = ("Mormyromast image gates (self only, clean gate: g_cons = 0, the own EOD's wall images removed; self "
+               "only, authors' mode: g_cons = 0 with the own EOD's wall images left in the reading, "
+               "sensors.mormyromast.wall_distortion on, as the authors' code reads it; cons only: g_self = 0)")
+
+
+def _mute_caption(measure: str) -> str:
+    return (f"Muting: {measure} per episode (points; box = quartiles) in the mute assay, from "
+            "analysis/behaviour/mute/episode_summary, in two designs side by side. Left, the Results' design, which "
+            "decides claim C12 (the one the authors' code runs): 2 agents in the uniform 70 x 70 cm arena, agent 1 "
+            "muted (muted) vs none (intact). Right, the Methods' design: 4 agents in the patchy 70 x 70 cm arena, "
+            "agent 0 muted (muted4) vs none (intact4). The conditions of a design share their episode seeds. Stars: "
+            "the condition_tests row of exactly that pair (measure " + measure + "); the behaviour analysis's "
+            "Dunnett rows test every condition against the assay's first (intact), so the 2-agent pair's stars are "
+            "Dunnett-adjusted over the assay's other conditions and the 4-agent pair has no row of its own (n/a); "
+            "the paired tests of claim C12 are in the claims table.")
+
+
 PANELS = [
     Panel("fig4", "A", condition_box("ablation1", "food_total", "Solo food", ablation_label), _summary("ablation1"),
           _caption("Receptor ablations, one agent", "ablation1", "food_total")),
@@ -149,18 +253,15 @@ PANELS = [
           _caption("Receptor ablations, four agents (bites given, summed over agents)", "ablation4", "bites")),
     Panel("fig4", "F", condition_box("ablation4", "theil_t", "Inequality", ablation_label), _summary("ablation4"),
           _caption("Receptor ablations, four agents (Theil T of food over all agents)", "ablation4", "theil_t")),
-    Panel("fig4", "G", condition_box("collective", "food_total", "Collective sensing: food"),
-          _summary("collective"), _caption("Mormyromast image gates (self only: g_cons = 0; cons only: g_self = 0)",
-                                           "collective", "food_total")),
-    Panel("fig4", "H", condition_box("collective", "eod_probability", "Collective sensing: EOD"),
-          _summary("collective"), _caption("Mormyromast image gates (self only: g_cons = 0; cons only: g_self = 0)",
-                                           "collective", "eod_probability")),
-    Panel("fig4", "I", condition_box("mute", "food_total", "Muting: group food"), _summary("mute"),
-          _caption("Agent 0 of four muted vs none", "mute", "food_total")
-          + " (Dunnett with one group; the paper's Mann-Whitney test is not in the analysis tables)."),
-    Panel("fig4", "J", condition_box("mute", "mean_nn_dist_cm", "Muting: spacing"), _summary("mute"),
-          _caption("Agent 0 of four muted vs none", "mute", "mean_nn_dist_cm")
-          + " (Dunnett with one group; the paper's Mann-Whitney test is not in the analysis tables)."),
+    Panel("fig4", "G", condition_box("collective", "food_total", "Collective sensing: food", collective_label,
+                                     COLLECTIVE_VARIANTS),
+          _summary("collective"), _caption(_COLLECTIVE, "collective", "food_total")),
+    Panel("fig4", "H", condition_box("collective", "eod_probability", "Collective sensing: EOD", collective_label,
+                                     COLLECTIVE_VARIANTS),
+          _summary("collective"), _caption(_COLLECTIVE, "collective", "eod_probability")),
+    Panel("fig4", "I", mute_box("food_total", "Muting: group food"), _summary("mute"), _mute_caption("food_total")),
+    Panel("fig4", "J", mute_box("mean_nn_dist_cm", "Muting: spacing"), _summary("mute"),
+          _mute_caption("mean_nn_dist_cm")),
     Panel("fig4", "K", layouts_box("food_total", "Patchy vs uniform: food"),
           {"patchy": "analysis/behaviour/patchy4/episode_summary.parquet",
            "uniform": "analysis/behaviour/uniform4/episode_summary.parquet"},

@@ -4,10 +4,12 @@ Who is who comes from the assay configs, not from the condition names: the
 one-patch conditions set ``env.roles`` (``resident`` = A at the patch,
 ``intruder`` = B), and the bot conditions set the bot (``env.bots``), the
 size pair (``env.sizes``), the bot's EOD rate and whether it is frozen.
-A lone agent is agent 0 whatever its role, so "A alone" and "B alone" are
-matched by role too. Size classes take ``style.ONEPATCH_CLASS_COLOURS``; in
-the bot assay the bot plays A (it sits at the patch), so "bot < B" has the
-colour of "A < B".
+A lone agent is agent 0 whatever its role, so the alone conditions are
+matched by role too, and each is matched to the size class whose role has its
+size (:func:`matched_alone`: B alone at 0.75 is the control of B in A<B).
+Size classes take ``style.ONEPATCH_CLASS_COLOURS``, an alone control a light
+tint of its class; in the bot assay the bot plays A (it sits at the patch), so
+"bot < B" has the colour of "A < B".
 """
 
 from __future__ import annotations
@@ -38,7 +40,10 @@ Tables = dict[str, pd.DataFrame]
 ROLE_LETTERS = {"resident": "A", "intruder": "B"}
 _ROLE_NAMES = {letter: role for role, letter in ROLE_LETTERS.items()}
 #: Short labels of the one-patch conditions (config/assay/onepatch.yaml); an unknown name is shown as is.
-CLASS_LABELS = {"A_lt_B": "A<B", "A_eq_B": "A=B", "A_gt_B": "A>B", "A_alone": "A alone", "B_alone": "B alone"}
+#: An alone control is labelled with the lone agent's size (on tick labels the size goes on a second line).
+CLASS_LABELS = {"A_lt_B": "A<B", "A_eq_B": "A=B", "A_gt_B": "A>B",
+                "A_alone_25": "A alone, 0.25", "A_alone_50": "A alone, 0.5", "A_alone_75": "A alone, 0.75",
+                "B_alone_25": "B alone, 0.25", "B_alone_50": "B alone, 0.5", "B_alone_75": "B alone, 0.75"}
 #: Bot size relation -> the one-patch class whose colour it takes (the bot plays the resident A).
 BOT_CLASSES = {"<": "A_lt_B", "=": "A_eq_B", ">": "A_gt_B"}
 #: Most bouts whose chaser and chased (or biter and bitten) are joined by a line in panels L and N.
@@ -53,6 +58,23 @@ def onepatch_roles() -> dict[str, dict[str, int]]:
     """Per one-patch condition: role letter ("A", "B") -> agent index, from each condition's ``env.roles``."""
     return {cond: {ROLE_LETTERS[r]: i for i, r in enumerate(cfg.env.roles) if r in ROLE_LETTERS}
             for cond, cfg in assay_conditions("onepatch").items()}
+
+
+def matched_alone() -> dict[tuple[str, str], str]:
+    """(role letter, social condition) -> the one-patch alone condition whose lone agent has that role and the size
+    the role has in the social condition (from each condition's ``env.roles`` and ``env.sizes``)."""
+    configs, roles = assay_conditions("onepatch"), onepatch_roles()
+    alone = {cond: (letter, configs[cond].env.sizes) for cond, r in roles.items() if len(r) == 1 for letter in r}
+    out = {}
+    for cond, r in roles.items():
+        sizes = configs[cond].env.sizes
+        if len(r) < 2 or not sizes:
+            continue
+        for letter, agent in r.items():
+            for a, (lone, s) in alone.items():
+                if lone == letter and len(s) == 1 and np.isclose(s[0], sizes[agent]):
+                    out[letter, cond] = a
+    return out
 
 
 def role_rows(table: pd.DataFrame, role: str) -> pd.DataFrame:
@@ -216,40 +238,70 @@ def trajectory_panel(condition: str) -> Callable[[Tables, object], None]:
 
 
 # ---------------------------------------------------------- E,F: food per role
+def class_slots(role: str, present) -> list[str]:
+    """The x slots of panels E-H for ``role``: each size class of the config present, then its size-matched alone
+    control (if present), an empty slot between classes; alone conditions matched to no class last. An empty slot
+    is a blank name, one space more for each (seaborn needs distinct categories)."""
+    present = set(present)
+    matched = matched_alone()
+    socials = [c for c, r in onepatch_roles().items() if len(r) == 2 and c in present]
+    rest = [c for c, r in onepatch_roles().items() if role in r and c in present and c not in socials
+            and c not in (matched.get((role, s)) for s in socials)]
+    groups = [[c, *([matched[role, c]] if matched.get((role, c)) in present else [])] for c in socials]
+    slots: list[str] = []
+    for i, group in enumerate([*groups, *([rest] if rest else [])]):
+        slots += [" " * i] * (i > 0) + group
+    return slots
+
+
+def _tick_label(cond: str) -> str:
+    return _class_label(cond).replace(", ", "\n") if cond.strip() else ""
+
+
 def food_by_role(role: str) -> Callable[[Tables, object], None]:
-    """Panels E (B) and F (A): food eaten per episode by ``role`` in each size class and alone."""
+    """Panels E (B) and F (A): food eaten per episode by ``role`` in each size class, beside ``role`` alone at the
+    size it has in that class; a bracket carries the class's Mann-Whitney stars (onepatch role_tests)."""
 
     def draw(tables: Tables, ax) -> None:
-        # imported here: the workflow imports every figure module to list the panels, and this one pulls in scipy
-        from ..analysis.onepatch import SOCIAL
-
         food = _usable(ax, tables["food"], "food_eaten", "onepatch food_per_agent")
         if food is None:
             return
         rows = role_rows(food, role)
-        order = [c for c in rows["condition"].cat.categories if c in set(rows["condition"])]
+        order = class_slots(role, rows["condition"].astype(str))
         if not order:
             missing(ax, f"no agent of role {role} in the onepatch food table")
             return
+        data = rows.assign(condition=rows["condition"].astype(str))
+        palette = {c: ONEPATCH_CLASS_COLOURS.get(c, NEUTRAL_COLOUR) for c in order}
+        if not box_strip(ax, data, "condition", "food_eaten", order, palette,
+                         labels={c: _tick_label(c) for c in order}):
+            return
         tests = tables["tests"]
         tests = tests[tests["role"] == role] if "role" in tests.columns else tests.iloc[:0]
-        # B: each social condition vs B alone; A: the social conditions pooled vs A alone (onepatch role_tests)
-        stars = ({c: stars_for(tests, group=c) for c in order if c in SOCIAL} if role == "B"
-                 else {f"{role}_alone": f"vs social: {stars_for(tests, group='social')}"})
-        box_strip(ax, rows.assign(condition=rows["condition"].astype(str)), "condition", "food_eaten", order,
-                  {c: ONEPATCH_CLASS_COLOURS.get(c, NEUTRAL_COLOUR) for c in order},
-                  stars=stars, labels={c: _class_label(c) for c in order})
-        ax.set_xlabel("size class of A vs B, or alone")
+        values = finite(data["food_eaten"])
+        lo, hi = float(values.min()), float(values.max())
+        pad = (hi - lo) * 0.06 or max(abs(hi), 1.0) * 0.06
+        matched = matched_alone()
+        for i, cond in enumerate(order):
+            alone = matched.get((role, cond))
+            if alone is None or i + 1 >= len(order) or order[i + 1] != alone:
+                continue
+            # the class vs the alone control at the same size: the row of role_tests with this class as group
+            top = finite(data.loc[data["condition"].isin([cond, alone]), "food_eaten"])
+            annotate_stars(ax, i, (top.max() if top.size else hi) + pad, stars_for(tests, group=cond), x2=i + 1)
+        ax.set_ylim(top=hi + 4 * pad)
+        ax.set_xlabel("size class of A vs B, and alone at the same size")
         ax.set_ylabel(f"food eaten by {role} (pellets / episode)")
         ax.set_title(f"Food of {role}: social vs alone")
 
-    draw.__doc__ = f"Panel: food eaten per episode by {role}, per one-patch condition."
+    draw.__doc__ = f"Panel: food eaten per episode by {role}, per size class and size-matched alone control."
     return draw
 
 
 # ------------------------------------------------------- G,H: food time course
 def food_course_by_role(role: str) -> Callable[[Tables, object], None]:
-    """Panels G (B) and H (A): mean +- SEM cumulative food of ``role`` over time, per class and alone."""
+    """Panels G (B) and H (A): mean +- SEM cumulative food of ``role`` over time, per size class (solid) and its
+    size-matched alone control (dashed, a tint of the class's colour)."""
 
     def draw(tables: Tables, ax) -> None:
         course = _usable(ax, tables["course"], "mean_food", "onepatch food_time_course")
@@ -257,21 +309,22 @@ def food_course_by_role(role: str) -> Callable[[Tables, object], None]:
             return
         rows = role_rows(course, role)
         fps = next(iter(assay_conditions("onepatch").values())).env.fps
-        for cond in rows["condition"].cat.categories:
+        matched = matched_alone()
+        alone = {a for (r, _), a in matched.items() if r == role}
+        for cond in (c for c in class_slots(role, rows["condition"].astype(str)) if c.strip()):
             c = rows[rows["condition"] == cond].sort_values("t")
-            if c.empty:
-                continue
             colour = ONEPATCH_CLASS_COLOURS.get(cond, NEUTRAL_COLOUR)
             t, mean, sem = c["t"] / fps, c["mean_food"], c["sem_food"].fillna(0)
             ax.fill_between(t, mean - sem, mean + sem, color=colour, alpha=0.25, lw=0)
-            ax.plot(t, mean, color=colour, lw=1.0, label=_class_label(cond),
-                    path_effects=_outline() if cond == "A_gt_B" else None)
+            light = cond in ("A_gt_B", matched.get((role, "A_gt_B")))  # the faint yellow class and its control
+            ax.plot(t, mean, color=colour, lw=1.0, ls="--" if cond in alone else "-", label=_class_label(cond),
+                    path_effects=_outline() if light else None)
         ax.set_xlabel("time (s)")
         ax.set_ylabel(f"cumulative food of {role} (pellets)")
         ax.set_title(f"Food of {role} over time")
         ax.legend(loc="best", fontsize=6)
 
-    draw.__doc__ = f"Panel: cumulative food of {role} over time, per one-patch condition."
+    draw.__doc__ = f"Panel: cumulative food of {role} over time, per size class and size-matched alone control."
     return draw
 
 
@@ -463,19 +516,21 @@ PANELS: list[Panel] = [
             "o marks the start, * each pellet eaten; dashed circle: the patch.")
       for letter, cond in zip("BCD", TRAJECTORY_CONDITIONS, strict=True)],
     Panel("fig5", "E", food_by_role("B"), {"food": _FOOD, "tests": _ROLE_TESTS},
-          "Food eaten per episode by the intruder B in each size class and alone (onepatch, behaviour "
-          "food_per_agent); box and every episode. Stars: Mann-Whitney of B's food in each social condition vs B "
-          "alone (onepatch role_tests, role B)."),
+          "Food eaten per episode by the intruder B in each size class (A<B, A=B, A>B), each beside B alone at the "
+          "size B has in that class (0.75, 0.5, 0.25; lighter box) (onepatch, behaviour food_per_agent); box and "
+          "every episode. Brackets: Mann-Whitney of B's food in the class vs B alone at the same size (onepatch "
+          "role_tests, role B, group = the class)."),
     Panel("fig5", "F", food_by_role("A"), {"food": _FOOD, "tests": _ROLE_TESTS},
-          "Food eaten per episode by the resident A in each size class and alone (onepatch, behaviour "
-          "food_per_agent); box and every episode. Stars over A alone: Mann-Whitney of A's food, social conditions "
-          "pooled, vs A alone (onepatch role_tests, role A)."),
+          "Food eaten per episode by the resident A in each size class, each beside A alone at the size A has in "
+          "that class (0.25, 0.5, 0.75; lighter box) (onepatch, behaviour food_per_agent); box and every episode. "
+          "Brackets: Mann-Whitney of A's food in the class vs A alone at the same size (onepatch role_tests, role "
+          "A, group = the class)."),
     Panel("fig5", "G", food_course_by_role("B"), {"course": _COURSE},
-          "Cumulative food of B over time, mean +- SEM over episodes, per size class and alone (onepatch, "
-          "onepatch food_time_course)."),
+          "Cumulative food of B over time, mean +- SEM over episodes, per size class (solid) and B alone at the "
+          "class's size of B (dashed, lighter) (onepatch, onepatch food_time_course)."),
     Panel("fig5", "H", food_course_by_role("A"), {"course": _COURSE},
-          "Cumulative food of A over time, mean +- SEM over episodes, per size class and alone (onepatch, "
-          "onepatch food_time_course)."),
+          "Cumulative food of A over time, mean +- SEM over episodes, per size class (solid) and A alone at the "
+          "class's size of A (dashed, lighter) (onepatch, onepatch food_time_course)."),
     Panel("fig5", "I", bot_reach("mobility"), {"reach": _REACH, "tests": _REACH_TESTS},
           "Fraction of episodes in which the trained agent B reached the patch, bot frozen vs moving, per size "
           "pair; each point one bot EOD rate (bot assay, onepatch reach_rates). Stars: Fisher exact test of B's "

@@ -41,15 +41,21 @@ GROUPSIZE_CONDITION = re.compile(r"^n(\d+)_(K|noK)$")
 KNOLLENORGAN_STATE = {"K": "K on", "noK": "K off"}
 KNOLLENORGAN_COLOURS = {"K on": RECEPTOR_COLOURS["knollenorgan"], "K off": NEUTRAL_COLOUR}
 KNOLLENORGAN_STYLES = {"K on": "-", "K off": "--"}
-#: Readable names of the decoding targets (steps columns, efish.analysis.dynamics.DECODE_TARGETS).
+#: Readable names of the decoding targets (steps columns, efish.analysis.dynamics.DECODE_TARGETS; a few older
+#: targets too, so that the tables of earlier runs still draw with names).
 TARGET_LABELS = {
     "dist_agent_cm": "nearest agent: distance", "bearing_agent_rad": "nearest agent: bearing",
     "dist_agent2_cm": "2nd agent: distance", "size_agent1": "nearest agent: size",
     "size_agent2": "2nd agent: size", "n_knollen_agents": "agents heard (K)",
+    "n_agents_100cm": "agents in K range (100 cm)",
     "dist_food_cm": "food: distance", "bearing_food_rad": "food: bearing", "food_count_5cm": "pellets within 5 cm",
     "dist_wall_cm": "wall: distance", "bearing_wall_rad": "wall: bearing", "size": "own size", "eod": "own EOD",
-    "turn_rad": "turn", "log_morm_field": "log field (M)", "log_amp_field": "log field (A)",
+    "turn_rad": "turn", "log_morm_field": "log field (M, geometric)", "log_morm_sensed": "log reading (M, sensed)",
+    "log_amp_field": "log field (A)",
 }
+#: Appended to the label of a readout target (the policy's own output or size, CLAIMS rule 7).
+READOUT_SUFFIX = " (readout)"
+READOUT_HATCH = "////"
 POWER_LABEL = "wideband power (1/Hz)"
 
 
@@ -113,9 +119,25 @@ def subsampling_curves(tables: Tables, ax) -> None:
     ax.legend(loc="upper left", fontsize=6, ncols=1)
 
 
+def readout_rows(decoding: pd.DataFrame) -> pd.Series:
+    """Which rows of a decoding table are readouts of the decoded vector (CLAIMS rule 7): its ``readout`` column,
+    or, in a table written before that column existed, membership of efish.analysis.dynamics.READOUT_TARGETS."""
+    if "readout" in decoding.columns:
+        return decoding["readout"].fillna(False).astype(bool)
+    # imported here: the workflow imports every figure module to list the panels, and dynamics pulls in sklearn
+    from ..analysis.dynamics import READOUT_TARGETS
+
+    return decoding["target"].isin(list(READOUT_TARGETS))
+
+
 def decoding_bars(assay: str, title: str, control: str | None = None):
-    """A draw function: decoding score per target (sorted, best on top), one bar colour per condition
-    (``control``, default the assay's first condition, grey)."""
+    """A draw function: decoding score per target, one bar colour per condition (``control``, default the assay's
+    first condition, grey).
+
+    The sensed targets are ranked, best on top; the readouts (the policy's own
+    turn and EOD, its own size: not sensing, CLAIMS rule 7) are not ranked
+    among them: they follow below a dashed line, hatched, labelled "(readout)".
+    """
     def draw(tables: Tables, ax) -> None:
         import seaborn as sns
 
@@ -125,11 +147,24 @@ def decoding_bars(assay: str, title: str, control: str | None = None):
             reasons = [r for r in decoding["reason"].astype(str) if r and r != "nan"]
             missing(ax, f"no decoding score in {assay}: {reasons[0] if reasons else 'empty table'}")
             return
-        scored = scored.assign(label=scored["target"].map(lambda t: TARGET_LABELS.get(t, t)))
-        ranking = scored.groupby("label")["score"].mean().sort_values(ascending=False).index.tolist()
+        readout = readout_rows(scored)
+        scored = scored.assign(label=scored["target"].map(lambda t: TARGET_LABELS.get(t, t))
+                               + np.where(readout, READOUT_SUFFIX, ""))
+
+        def ranked(rows: pd.DataFrame) -> list[str]:
+            return rows.groupby("label")["score"].mean().sort_values(ascending=False).index.tolist()
+
+        sensed, readouts = ranked(scored[~readout]), ranked(scored[readout])
         conditions = condition_order(assay, scored["condition"], control)
-        sns.barplot(data=scored, x="score", y="label", hue="condition", order=ranking, hue_order=conditions,
-                    palette=condition_palette(conditions, control), orient="h", legend=len(conditions) > 1, ax=ax)
+        sns.barplot(data=scored, x="score", y="label", hue="condition", order=sensed + readouts,
+                    hue_order=conditions, palette=condition_palette(conditions, control), orient="h",
+                    legend=len(conditions) > 1, ax=ax)
+        for bar in ax.patches:  # bars sit at y = their label's index in the order
+            if bar.get_height() > 0 and round(bar.get_y() + bar.get_height() / 2) >= len(sensed):
+                bar.set_hatch(READOUT_HATCH)
+                bar.set_alpha(0.5)
+        if sensed and readouts:
+            ax.axhline(len(sensed) - 0.5, color=NEUTRAL_COLOUR, lw=0.5, ls="--")
         ax.axvline(0.0, color="black", lw=0.5)
         ax.set_xlabel("decoding score (R$^2$ - baseline R$^2$)")
         ax.set_ylabel("decoded variable")
@@ -286,10 +321,14 @@ PANELS = [
           "Cross-validated linear decoding of step variables from the homer's hidden state (score = held-out R^2 "
           "minus that of the training mean; folds grouped by episode), electric and ray-casting homing policies, "
           "analysis/dynamics/homing/decoding; targets without a score (e.g. no food in the arena) are left out. "
+          "Readouts of the state itself (own turn, EOD, size) are drawn hatched below the dashed line, not ranked. "
           "The Knollenorgan error angle is not a decoding target of the analysis yet."),
     Panel("fig6", "E", decoding_bars("wide2", "Two agents: decoding"), {"decoding": _dyn("wide2", "decoding")},
           "Decoding score per step variable from the hidden state of both agents of the wide2 assay (160 x 40 cm), "
-          "ranked best first, analysis/dynamics/wide2/decoding; targets without a score are left out."),
+          "analysis/dynamics/wide2/decoding. Each state is decoded against the world it has observed (the step's "
+          "observation it has taken in). The sensed variables are ranked best first; the readouts of the decoded "
+          "vector itself (the agent's own turn and EOD, fed back in its observation, and its own size) are drawn "
+          "hatched below the dashed line and not ranked (CLAIMS rule 7). Targets without a score are left out."),
     Panel("fig6", "F", food_decoding_bars, {"food_decoding": _dyn("wide2", "food_decoding")},
           "Decoding score of the food variables (distance and bearing of the nearest pellet) from the hidden states "
           "of the wide2 agents on the steps with that pellet within analysis.claims_food_near_cm (near, in receptor "

@@ -25,8 +25,27 @@ CONDITION_COLOURS = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56
 #: Size classes from small to large (ranks within an episode, or the one-patch A-vs-B classes): one
 #: sequential palette, light = small, dark = large.
 SIZE_CLASS_CMAP = "viridis_r"
-ONEPATCH_CLASS_COLOURS = {"A_lt_B": "#440154", "A_eq_B": "#21918c", "A_gt_B": "#b89b00",
-                          "A_alone": "#7f7f7f", "B_alone": "#bfbfbf"}
+_ONEPATCH_SOCIAL = {"A_lt_B": "#440154", "A_eq_B": "#21918c", "A_gt_B": "#b89b00"}
+
+
+def tint(colour: str, amount: float = 0.5) -> str:
+    """``colour`` (``#rrggbb``) mixed with white: ``amount`` 0 is the colour, 1 is white.
+
+    >>> tint("#000000", 0.5)
+    '#808080'
+    """
+    rgb = [int(colour[i:i + 2], 16) for i in (1, 3, 5)]
+    return "#" + "".join(f"{round(c + (255 - c) * amount):02x}" for c in rgb)
+
+
+#: The one-patch size classes, and each size-matched alone control (config/assay/onepatch.yaml) in a light tint of
+#: the class it is the control of: A alone at 0.75 and B alone at 0.25 go with A>B, both at 0.5 with A=B, A alone
+#: at 0.25 and B alone at 0.75 with A<B (efish.analysis.onepatch.MATCHED_ALONE).
+_S = _ONEPATCH_SOCIAL
+ONEPATCH_CLASS_COLOURS = {**_S,
+                          "A_alone_75": tint(_S["A_gt_B"]), "A_alone_50": tint(_S["A_eq_B"]),
+                          "A_alone_25": tint(_S["A_lt_B"]), "B_alone_25": tint(_S["A_gt_B"]),
+                          "B_alone_50": tint(_S["A_eq_B"]), "B_alone_75": tint(_S["A_lt_B"])}
 #: Decoding with the nearest food in receptor range (near) or beyond it (far), Fig 6F.
 FOOD_RANGE_COLOURS = {"near": "#009E73", "far": "#7f7f7f"}
 #: Sequential colour map of every heat map (bite matrices, field maps use their own diverging one).

@@ -1,12 +1,14 @@
 """What the steps table records about each agent at each step, beyond the state itself (SPEC 12, Fig 6 targets).
 
-Pure numpy on an env's state after a step: distances and bearings to the
-nearest bodies, the sizes of the nearest agents, food counts near the agent by
-sector, the realised turn, how many conspecifics the Knollenorgans hear, and
-the physics quantities the analyses must not recompute (error angles of a
-homer against its target's local fields; log10 of the Mormyromast- and
-Ampullary-relevant fields at the body centre). Every function returns arrays
-[B, N] keyed by their column names.
+Pure numpy on an env's state after a step (or on the observation the step
+returned): distances and bearings to the nearest bodies, the sizes of the
+nearest agents, food counts near the agent by sector, the realised turn, how
+many conspecifics the Knollenorgans hear and how many are within Knollenorgan
+range, log10 of the Mormyromast reading as sensed, and the physics quantities
+the analyses must not recompute (error angles of a homer against its target's
+local fields; log10 of the Mormyromast- and Ampullary-relevant fields at the
+body centre). Every function returns arrays [B, N] keyed by their column names
+(or one such array).
 """
 
 from __future__ import annotations
@@ -75,6 +77,49 @@ def knollen_agents(knollen_block: np.ndarray, slots: int) -> np.ndarray:
     """Conspecifics heard: slots of the Knollenorgan observation block [B, N, slots * K] with any spike."""
     b, n, width = knollen_block.shape
     return (knollen_block.reshape(b, n, slots, width // slots) != 0).any(-1).sum(-1)
+
+
+def agents_in_range(env: VecEnv, range_cm: float) -> np.ndarray:
+    """Other agents whose centre is closer than ``range_cm`` to each agent's centre (int [B, N]).
+
+    The authors' "agents in Knollenorgan range" decoding target (a strict
+    ``<``, as theirs): a count of the world around the agent, whether or not
+    those agents emitted on the step (:func:`knollen_agents` counts those
+    heard, which also depends on their EODs).
+    """
+    xy = env.state.xy
+    d = np.linalg.norm(xy[:, None, :, :] - xy[:, :, None, :], axis=-1)   # [B, N(i), N(j)]
+    others = ~np.eye(env.n, dtype=bool)
+    return ((d < range_cm) & others).sum(-1)
+
+
+def log_morm_sensed(morm_block: np.ndarray, e_min: float, e_max: float) -> np.ndarray:
+    """log10 (V/m) of the strongest Mormyromast reading each agent sensed, from its observation block [B, N, M].
+
+    The reading is the one the channel delivers: after the baseline
+    subtraction of SPEC 3.1 (the own and conspecific direct EODs removed, so
+    it holds the self image only when the agent emitted, and the gained
+    conspecific image otherwise), with the sensor noise, clipped to
+    [``e_min``, ``e_max``]. The log normalisation of SPEC 3.4 is inverted:
+    log10 |s| = log10 e_min + |y| (log10 e_max - log10 e_min) where y != 0.
+    NaN where no sensor reads above ``e_min`` (y = 0 everywhere: nothing is
+    sensed, and the true value is only known to be below e_min; decoding drops
+    these rows rather than invent a value). A saturated sensor gives log10 e_max.
+
+    Why the largest reading: the authors decode log10 |E| of the baseline-
+    subtracted field vector at the body centre, a point without a sensor
+    (``mormyromast_field_mag_log`` from ``center_field``, KempnerInstitute/wef
+    analysis_rnn_decoding.py and sensing.py). On the ring of sensors, whose
+    normals span every direction, the largest |E.n| is that magnitude up to
+    the sensors' angular spacing (at most 11.1 deg, so >= 0.995 of it for a
+    uniform field) and the field's variation over the 1 cm radius; any one
+    sensor (e.g. the chin's) reads only the component along its normal. Unlike
+    the authors' centre vector, this carries the channel's noise, clipping and
+    the x k_cons gain of a silent agent: it is what the policy received.
+    """
+    y = np.abs(np.asarray(morm_block, dtype=np.float64)).max(axis=-1)
+    lo, hi = np.log10(e_min), np.log10(e_max)
+    return np.where(y > 0, lo + y * (hi - lo), np.nan)
 
 
 def eod_field(xy_m: np.ndarray, heading: np.ndarray, at_m: np.ndarray, cfg: EfishConfig) -> np.ndarray:

@@ -8,7 +8,16 @@ import pandas as pd
 from ..config.schema import EfishConfig
 from ..env.observe import observation_slices
 from ..env.vec_env import VecEnv
-from .measures import food_counts, homing_errors, knollen_agents, log_fields, nearest, wrap
+from .measures import (
+    agents_in_range,
+    food_counts,
+    homing_errors,
+    knollen_agents,
+    log_fields,
+    log_morm_sensed,
+    nearest,
+    wrap,
+)
 
 
 def run_episodes(cfg: EfishConfig, policy, episodes: int, condition: str = "control", seed: int = 0,
@@ -20,6 +29,13 @@ def run_episodes(cfg: EfishConfig, policy, episodes: int, condition: str = "cont
     termination, e.g. homing's success, or the time limit) and not after it:
     its ``steps`` and ``return`` count only those steps.
 
+    The ``hidden`` row (episode, t, agent) is the state that has taken in the
+    observation step t returned, i.e. the world the ``steps`` row t describes,
+    and has not yet acted on it (see :func:`hidden_table`): it is the state the
+    next ``act`` call returns. So that the last recorded step has one too, the
+    policy is called once more on the final observation; that call's actions
+    are discarded, and nothing else (actions, steps, food) depends on it.
+
     ``policy`` has ``initial_hidden(B, N)`` and ``act(obs, hidden, starts, deterministic)`` like
     :class:`efish.rl.policy.Policy`.
     """
@@ -30,20 +46,26 @@ def run_episodes(cfg: EfishConfig, policy, episodes: int, condition: str = "cont
     food = FoodLog(env)
     steps, states, bites_recv = [], [], np.zeros((B, N), int)
     running = np.ones(B, bool)  # arenas whose episode has not ended: only they are recorded
+    seen = None  # rows recorded at the previous step: the state act returns next has taken in their observation
     for t in range(T):
         actions, hidden = policy.act(obs, hidden, starts, deterministic)
+        if record_hidden and seen is not None:
+            states.append(hidden.reshape(B * N, -1)[seen].astype(np.float32))
         alive_before, heading_before = env.state.alive.copy(), env.state.heading.copy()
         obs, reward, term, trunc, info = env.step(actions)
         food.update(env, alive_before, t, running, info["eaten_slot"])
-        rows = np.repeat(running, N)
-        steps.append({k: v[rows] for k, v in step_columns(env, obs, reward, term, info, heading_before, t).items()})
-        if record_hidden:
-            states.append(hidden.reshape(B * N, -1)[rows].astype(np.float32))
+        seen = np.repeat(running, N)
+        steps.append({k: v[seen] for k, v in step_columns(env, obs, reward, term, info, heading_before, t).items()})
         bites_recv += info["bitten_by"] * running[:, None]
         starts = np.zeros(B)
         running &= ~(term | trunc)
         if not running.any():
             break
+    if record_hidden:
+        # the state that has taken in the last step's observation; deterministic, so that the discarded action
+        # draws from no random stream a later sampling call would use
+        _, hidden = policy.act(obs, hidden, starts, True)
+        states.append(hidden.reshape(B * N, -1)[seen].astype(np.float32))
     # one frame per table at the end: building a frame per step costs more than the step itself
     steps_df = pd.DataFrame({k: np.concatenate([step[k] for step in steps]) for k in steps[0]})
     steps_df.insert(0, "condition", condition)
@@ -78,16 +100,27 @@ def step_columns(env: VecEnv, obs: np.ndarray, reward: np.ndarray, term: np.ndar
         "success": np.repeat(term & success, N).reshape(B, N),
         **nearest(env), **food_counts(env),
         "n_knollen_agents": knollen_agents(knoll, slots) if electric else np.zeros((B, N), int),
+        "n_agents_100cm": agents_in_range(env, cfg.sensors.knollenorgan.range_cm),
         "morm_abs_mean": np.abs(obs[..., sl["mormyromast"]]).mean(-1) if electric else np.full((B, N), np.nan),
         "amp_abs_mean": np.abs(obs[..., sl["ampullary"]]).mean(-1) if electric else np.full((B, N), np.nan),
         "knollen_spikes": (knoll != 0).sum(-1) if electric else np.zeros((B, N), int),
+        "log_morm_sensed": (log_morm_sensed(obs[..., sl["mormyromast"]], cfg.sensors.mormyromast.e_min,
+                                            cfg.sensors.mormyromast.e_max) if electric else np.full((B, N), np.nan)),
         **log_fields(env), **homing_errors(env),
     }
     return {k: np.ravel(v) for k, v in columns.items()}
 
 
 def hidden_table(keys: pd.DataFrame, hidden: np.ndarray) -> pd.DataFrame:
-    """The GRU states [rows, H] beside their keys (episode, t, agent), float32 columns h_0 ... h_{H-1}."""
+    """The GRU states [rows, H] beside their keys (episode, t, agent), float32 columns h_0 ... h_{H-1}.
+
+    Convention: the state of row t has taken in the observation that step t
+    returned (the world after step t, which the ``steps`` row t describes) and
+    has produced none of row t's actions (those came from the state before).
+    Merging ``hidden`` and ``steps`` on (condition, episode, t, agent) thus
+    pairs each state with the world it has observed (CLAIMS rule 7), never with
+    the action it produced.
+    """
     units = pd.DataFrame(hidden, columns=[f"h_{i}" for i in range(hidden.shape[1])])
     return pd.concat([keys.reset_index(drop=True), units], axis=1)
 

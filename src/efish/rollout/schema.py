@@ -42,10 +42,16 @@ STEP_COLUMNS = KEYS + STEP_KEYS + [
     ("food_front_5cm", I16, "of them within pi/4 of the heading"), ("food_left_5cm", I16, "of them on the left"),
     ("food_back_5cm", I16, "of them behind"), ("food_right_5cm", I16, "of them on the right"),
     ("n_knollen_agents", I16, "conspecifics whose EOD crosses the Knollenorgan threshold (heard)"),
+    ("n_agents_100cm", I16, ("other agents whose centre is closer than sensors.knollenorgan.range_cm (default "
+                             "100 cm): in Knollenorgan range, emitting or not")),
     ("morm_abs_mean", F32, "mean |normalised Mormyromast reading|"),
     ("amp_abs_mean", F32, "mean |normalised Ampullary reading|"),
     ("knollen_spikes", I16, "Knollenorgan sensors spiking, all slots"),
-    ("log_morm_field", F32, "log10 |E| (V/m) at the body centre of the dipoles the own EOD induces on others"),
+    ("log_morm_field", F32, ("log10 |E| (V/m) at the body centre of the dipoles the own EOD induces on others "
+                             "(geometric: the own EOD taken as on, free space)")),
+    ("log_morm_sensed", F32, ("log10 (V/m) of the largest Mormyromast reading as sensed (after the baseline "
+                              "subtraction, so the self image only when emitting; noise, clip at E_max), from the "
+                              "observation; NaN when no sensor reads above E_min")),
     ("log_amp_field", F32, "log10 |E| (V/m) at the body centre of the other bodies' intrinsic dipoles"),
     ("err_morm_rad", F32, "homing: heading minus the direction of the target's induced-dipole field, rad"),
     ("err_amp_rad", F32, "homing: heading minus the direction of the target's intrinsic field, rad"),
@@ -68,7 +74,11 @@ FOOD_COLUMNS = KEYS + [
     ("eaten_by", I16, "agent that ate it, -1 never"),
 ]
 
-HIDDEN_COLUMNS = KEYS + STEP_KEYS[:1] + STEP_KEYS[2:]  # then h_0 .. h_{H-1}, float32: the GRU state after the step
+# then h_0 .. h_{H-1}, float32: the GRU state that has taken in the observation step t returned (the world of the
+# steps row t) and produced none of row t's actions; see efish.rollout.run.hidden_table
+HIDDEN_COLUMNS = KEYS + STEP_KEYS[:1] + STEP_KEYS[2:]
+HIDDEN_UNITS = ("the policy's GRU state after taking in the observation of step t (the world of the steps row "
+                "with the same keys), before acting on it; one column per unit")
 
 COLUMNS = {"steps": STEP_COLUMNS, "episodes": EPISODE_COLUMNS, "food": FOOD_COLUMNS, "hidden": HIDDEN_COLUMNS}
 
@@ -92,7 +102,7 @@ def describe(name: str) -> str:
         raise ValueError(f"unknown table {name!r}: choose one of {', '.join(COLUMNS)}")
     rows = [(n, str(k), d) for n, k, d in COLUMNS[name]]
     if name == "hidden":
-        rows.append(("h_0 .. h_{H-1}", "float", "the policy's GRU state after the step, one column per unit"))
+        rows.append(("h_0 .. h_{H-1}", "float", HIDDEN_UNITS))
     width = max(len(n) for n, _, _ in rows)
     return "\n".join(f"{n:<{width}}  {k:<7}  {d}" for n, k, d in rows)
 
