@@ -521,6 +521,8 @@ def paired_part(ctx: Context, summary: pd.DataFrame, measure: str, condition: st
     ci = ctx.ci(diff, median_minus("diff", 0.0), strata=None)
     note = f"paired over {len(both)} shared episodes, Holm over {len(rows)} conditions vs {control}"
     out = from_row(row, sign, ci)
+    if out.reason.startswith("all paired differences are zero"):  # e.g. no condition ate anything: no evidence
+        return dataclasses.replace(out, verdict="not decidable", reason=f"{out.reason} ({note})")
     if sign == 0:
         margin, how = margin_for(ctx, both[control].to_numpy(), both[condition].to_numpy())
         out = dataclasses.replace(out, p_equiv=tost_paired(diff["diff"].to_numpy(), margin), margin=margin)

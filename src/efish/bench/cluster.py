@@ -144,8 +144,10 @@ class CostModel:
         if rule == "train_policy":
             return self._training(f"policy={wc['policy']}")
         assay = "selection" if rule == "evaluate_seed" else wc.get("assay")
-        if assay and (rule in ("evaluate_seed", "assay", "assay_with_hidden", "top_seed_assay")
-                      or rule.startswith("analysis_")):
+        # the top seeds' assays and analyses are the same work as the selected seed's
+        if assay and (rule in ("evaluate_seed", "assay", "assay_with_hidden", "top_seed_assay",
+                               "top_seed_assay_with_hidden")
+                      or rule.startswith(("analysis_", "top_seed_analysis_"))):
             steps = self._assay_steps(assay)
             return steps, steps
         return None

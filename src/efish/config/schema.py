@@ -319,7 +319,8 @@ class ScaleConfig:
     max_episodes: int = param(8, "cap on the episodes per assay condition (SPEC 11 counts at paper scale)", lo=1)
     selection_episodes: int = param(8, "patchy4 episodes per seed for seed selection (SPEC 10)", lo=1)
     max_episode_steps: int = param(100_000, "cap on an assay episode's length (the smoke scale shortens them)", lo=1)
-    top_seeds: int = param(3, "the best-ranked seeds that also run the top_seed_assays (supplement)", lo=0)
+    top_seeds: int = param(3, "the best-ranked seeds (the selected one first): the others rerun every claim's assays "
+                           "for seeds_agree, and all run the top_seed_assays (supplement)", lo=0)
     top_seed_assays: list = param(["patchy4", "wide2", "square2"], "assays the top seeds run")
     assays: list = param(["homing", "patchy4", "uniform4", "wide2", "square2", "ablation4", "ablation1",
                           "collective", "mute", "npatch", "food_scarcity", "onepatch", "bot", "groupsize"],
