@@ -503,6 +503,29 @@ def test_the_authors_self_only_mode_is_reported_beside_and_does_not_decide():
     assert row["verdict"] == "holds"
 
 
+def test_no_planted_effect_at_large_n_is_weaker_not_holds_nor_fails():
+    """C12 with muting doing nothing, 200 episodes: neither part holds or fails."""
+    tables = behaviour_tables("mute", {"intact": {}, "muted": {}}, "intact", episodes=200)
+    row = cl.CLAIMS["C12"].run(tables, CFG)
+    assert row["verdict"] == "weaker", row["reason"]
+    assert "group food, 2 agents: weaker" in row["reason"] and "spacing, 2 agents: weaker" in row["reason"]
+
+
+def test_c13_holds_on_a_sweep_where_intake_and_inequality_fall_with_the_patch_count():
+    row = cl.CLAIMS["C13"].run(c13(False), CFG)
+    for part in ("iso/free food vs n: holds", "iso excess Theil vs n: holds", "free excess Theil vs n: holds"):
+        assert part in row["reason"]
+
+
+def test_c19_ignores_a_perfectly_decodable_turn_and_ranks_the_sensed_variables():
+    """The policy's own turn is decoded perfectly (a readout, rule 7): it is no competitor, and the nearest-agent
+    distance, the best sensed variable, makes the claim hold."""
+    tables = c19(False)
+    row = cl.CLAIMS["C19"].run(tables, CFG)
+    assert row["verdict"] == "holds", row["reason"]
+    assert "turn_rad" not in row["reason"] and "mean skill: dist_agent_cm" in row["reason"]
+
+
 def test_bootstrap_reruns_are_identical_and_the_seed_matters():
     tables = c12(False)
     first, again = cl.CLAIMS["C12"].run(tables, CFG), cl.CLAIMS["C12"].run(tables, CFG)
