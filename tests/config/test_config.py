@@ -6,8 +6,16 @@ import pytest
 
 from efish.config import ConfigError, EfishConfig, compose, config_dir, to_yaml, validate
 from efish.config.schema import (
-    AnalysisConfig, ArenaConfig, AssayConfig, BenchConfig, EnvConfig, PhysicsConfig, ScaleConfig, SensorsConfig,
-    SceneConfig, TrainConfig,
+    AnalysisConfig,
+    ArenaConfig,
+    AssayConfig,
+    BenchConfig,
+    EnvConfig,
+    PhysicsConfig,
+    ScaleConfig,
+    SceneConfig,
+    SensorsConfig,
+    TrainConfig,
 )
 
 from ..helpers import cfg_with

@@ -9,7 +9,8 @@ from scipy import stats
 from efish.env.observe import ray_observation_slices
 from efish.env.raycast import KIND_AGENT, KIND_FOOD, KIND_NONE, KIND_WALL, cast_rays
 
-from ..helpers import BIG, actions, make_env as make
+from ..helpers import BIG, actions
+from ..helpers import make_env as make
 
 
 def test_bot_stays_within_its_bound_and_emits_at_its_rate():

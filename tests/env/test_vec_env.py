@@ -6,10 +6,12 @@ import numpy as np
 import pytest
 
 from efish.config import ConfigError, compose
-from efish.env import VecEnv, parallel_env
+from efish.env import parallel_env
 from efish.env.observe import observation_slices
 
-from ..helpers import BIG, actions, make_env as make
+from ..helpers import BIG, actions
+from ..helpers import make_env as make
+
 
 def place_pellets(env, xy):
     env.state.alive[:] = False
@@ -153,7 +155,7 @@ def test_same_seed_same_bits_and_different_seeds_differ():
 def test_truncation_resets_and_keeps_the_final_observation():
     env = make("env.episode_steps=3", num_envs=2)
     env.reset()
-    for k in range(3):
+    for _ in range(3):
         obs, _, term, trunc, info = env.step(actions(env))
     assert trunc.all() and not term.any() and "final_obs" in info
     assert (env.state.t == 0).all()

@@ -10,11 +10,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from tests.helpers import rollout_tables
 
 from efish.analysis.registry import analyses_for, run, tables_written
 from efish.analysis.selection import rank_seeds, seed_statistics, stack_top_seeds
 from efish.config import compose
-from tests.helpers import rollout_tables
 
 SEEDS = 2
 

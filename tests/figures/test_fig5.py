@@ -108,7 +108,7 @@ def test_food_of_b_draws_b_food_of_every_condition(synthetic_results):
     labels = [t.get_text() for t in ax.get_xticklabels()]
     # each size class beside B alone at the size B has in it, an empty slot between classes
     assert labels == ["A<B", "B alone\n0.75", "", "A=B", "B alone\n0.5", "", "A>B", "B alone\n0.25"]
-    for i, cond in [(0, "A_lt_B"), (1, "B_alone_75"), (6, "A_gt_B"), (7, "B_alone_25")]:
+    for i, cond in [(0, "A_lt_B"), (1, "B_alone_75"), (6, "A_gt_B"), (7, "B_alone_25")]:  # noqa: B007 (@cond)
         mine = fig5.role_rows(food, "B").query("condition == @cond")["food_eaten"].to_numpy(float)
         ys = [off[np.abs(off[:, 0] - i) < 0.4, 1] for c in ax.collections if len(off := c.get_offsets())]
         assert np.array_equal(np.sort(np.concatenate(ys)), np.sort(mine))

@@ -6,10 +6,10 @@ import string
 
 import pytest
 
+from efish.config import compose
 from efish.figures.registry import PANELS, drawable
 from efish.figures.render import draw_panel, load_tables, render_panel
 from efish.figures.style import panel_style
-from efish.config import compose
 
 
 def letters(last: str) -> list[str]:

@@ -19,6 +19,8 @@ numbers (the supplement's figures are estimates at the E_min thresholds), so
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -133,7 +135,7 @@ def test_detection_fades_monotonically_with_distance(cfg):
     peaks = [float(np.abs(observer_reads(sense(pellet_ahead(d, 0.0, True), cfg), "mormyromast")).max())
              for d in np.arange(1.5, 9.0, 0.25)]
     assert peaks[0] > 0.5 and peaks[-1] == 0
-    assert all(a > b or a == b == 0 for a, b in zip(peaks, peaks[1:])), peaks
+    assert all(a > b or a == b == 0 for a, b in itertools.pairwise(peaks)), peaks
 
 
 def test_front_sensors_read_prey_ahead_the_strongest(cfg):

@@ -14,8 +14,8 @@ import pytest
 
 from efish.physics import kernels as kn
 from efish.physics.fast import kernel_constants
-from efish.physics.plan import build_plan
 from efish.physics.kernel_inputs import Arena
+from efish.physics.plan import build_plan
 from efish.physics.sense_kernel import B_ALPHA, B_M2X, B_M2Y, B_X, B_Y, N_BODY, drop_culled_bodies
 from efish.physics.sources import BLOCK
 

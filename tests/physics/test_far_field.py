@@ -46,7 +46,7 @@ def test_single_dipole_error_is_within_the_model_bound(q):
             pos = np.array([[dist * np.cos(a), dist * np.sin(a)]])
             moment = 1e-13 * np.array([[np.cos(phi), np.sin(phi)]])
 
-            def reading(t):
+            def reading(t, pos=pos, moment=moment):
                 u = np.stack([np.cos(t), np.sin(t)], axis=1)
                 return np.einsum("si,si->s", dipole_field(r * u, pos, moment), u)
 

@@ -138,6 +138,6 @@ def test_image_set_is_mirror_symmetric(order):
     idx = image_indices(order)
     pos, mom, _ = image_sources(xy, vec, W, H, idx, 0.95)
     pos_m, mom_m, _ = image_sources(np.array([[W - 0.13, 0.31]]), np.array([[-0.6, -0.8]]), W, H, idx, 0.95)
-    a = {tuple(np.round(np.r_[W - p[0], p[1], -m[0], m[1]], 12)) for p, m in zip(pos, mom)}
-    b = {tuple(np.round(np.r_[p, m], 12)) for p, m in zip(pos_m, mom_m)}
+    a = {tuple(np.round(np.r_[W - p[0], p[1], -m[0], m[1]], 12)) for p, m in zip(pos, mom, strict=True)}
+    b = {tuple(np.round(np.r_[p, m], 12)) for p, m in zip(pos_m, mom_m, strict=True)}
     assert a == b

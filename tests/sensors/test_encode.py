@@ -106,7 +106,7 @@ def test_noise_uniforms_reproduce_the_four_uniform_calls_of_the_spec():
     u = noise_uniforms(raw, b)
     ends = np.cumsum([raw.mormyromast.size, raw.ampullary.size, raw.ampullary.size])
     lows, highs = [lo, lo, jlo, lo], [hi, hi, jhi, hi]
-    got = np.concatenate([low + (high - low) * part for low, high, part in zip(lows, highs, np.split(u, ends))])
+    got = np.concatenate([low + (high - low) * part for low, high, part in zip(lows, highs, np.split(u, ends), strict=True)])
     assert_bits(got, want)
     assert a.random() == b.random()
 

@@ -85,7 +85,7 @@ def bench_accuracy(cfg: EfishConfig, progress=None) -> pd.DataFrame:
     settings = accuracy_settings(cfg)
     for s in (progress(settings) if progress else settings):
         plan = build_plan(_setting_config(cfg, s))
-        seconds = best_time(lambda: sense_batch(batch, plan), bc.repeats)
+        seconds = best_time(lambda plan=plan: sense_batch(batch, plan), bc.repeats)
         model = (s["image_order"], s["softening_m"])
         if model not in same_model:
             exact_cfg = _with_physics(cfg, image_order=model[0], softening_m=model[1], tolerance=0.0, dtype="float64")
@@ -125,7 +125,7 @@ def plot_accuracy(df: pd.DataFrame, path: str | Path) -> None:
     panels = (("max_abs_error", "vs high-accuracy reference (float64, tol 0, image order 3)"),
               ("max_abs_error_same_model", "vs exact result of the same image order and softening"))
     markers = {"float64": "o", "float32": "s"}
-    for ax, (column, title) in zip(axes, panels):
+    for ax, (column, title) in zip(axes, panels, strict=True):
         err = df[column].clip(lower=floor)
         for (dtype, order), g in df.groupby(["dtype", "image_order"]):
             ax.scatter(g["us_per_agent_step"], err[g.index], marker=markers.get(dtype, "o"),

@@ -95,7 +95,7 @@ def bench_budget(cfg: EfishConfig, hiddens: tuple[int, ...], seeds: int, minutes
     with ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn")) as pool:
         futures = [pool.submit(train_for, cfg, h, s, seconds) for h, s in runs]
         results = []
-        for (h, s), fut in zip(runs, futures):
+        for (h, s), fut in zip(runs, futures, strict=True):
             results.append(fut.result())
             if progress:
                 progress(f"width {h} seed {s}")

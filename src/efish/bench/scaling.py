@@ -149,7 +149,7 @@ def plot_scaling(df: pd.DataFrame, path: str | Path) -> None:
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.5), constrained_layout=True)
     panels = (("pellets", "pellets", "pellets per arena (sweep of arena size; crowded ringed)"),
               ("agents", "n_agents", "agents per arena"))
-    for ax, (sweep, xcol, xlabel) in zip(axes, panels):
+    for ax, (sweep, xcol, xlabel) in zip(axes, panels, strict=True):
         g = df[df["sweep"] == sweep]
         if g.empty:
             from ..figures.style import missing
@@ -169,7 +169,7 @@ def plot_scaling(df: pd.DataFrame, path: str | Path) -> None:
         span = np.geomspace(x.min(), x.max(), 50)
         ax.plot(span, np.full_like(span, y0), ":", color="grey", label="constant")
         ax.plot(span, y0 * span / x0, ":", color="k", label="linear in the work")
-        for xi, (_, r) in zip(x, g.iterrows()):
+        for xi, (_, r) in zip(x, g.iterrows(), strict=True):
             ax.annotate(r["case"], (xi, r["fast_us_per_agent_step"]), fontsize=6, xytext=(3, -9),
                         textcoords="offset points")
         ax.set(xscale="log", yscale="log", xlabel=xlabel, ylabel="us per agent-step (one thread)")

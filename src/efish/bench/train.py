@@ -30,7 +30,7 @@ def gemm_flops(dtype: torch.dtype, sizes: tuple[int, ...] = (512, 1024, 2048), r
     best = 0.0
     for n in sizes:
         a, b = torch.randn(n, n).to(dtype), torch.randn(n, n).to(dtype)
-        best = max(best, 2 * n ** 3 / best_time(lambda: a @ b, repeats))
+        best = max(best, 2 * n ** 3 / best_time(lambda a=a, b=b: a @ b, repeats))
     return best
 
 

@@ -18,8 +18,8 @@ import hashlib
 import os
 import pickle
 import re
-from pathlib import Path
 from collections.abc import Callable, Sequence
+from pathlib import Path
 from typing import TypeVar
 
 from .schema import ConfigError, EfishConfig, validate

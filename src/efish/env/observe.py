@@ -22,7 +22,7 @@ TAIL_SIZES = (4, 1, 1, 1, 2, 1, 1)
 
 def _slices(names, sizes) -> dict[str, slice]:
     edges = np.cumsum((0,) + tuple(sizes))
-    return {k: slice(int(a), int(b)) for k, a, b in zip(names, edges[:-1], edges[1:])}
+    return {k: slice(int(a), int(b)) for k, a, b in zip(names, edges[:-1], edges[1:], strict=True)}
 
 
 def perception_width(cfg: EfishConfig) -> int:

@@ -7,6 +7,7 @@ both, so the two give the same outputs for the same sequence.
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import torch
@@ -57,7 +58,7 @@ class RecurrentTrunk(nn.Module):
         cuts = torch.nonzero(starts.any(dim=1)).flatten().tolist()
         bounds = sorted(set([0, x.shape[0]] + cuts))
         outs = []
-        for a, b in zip(bounds[:-1], bounds[1:]):
+        for a, b in itertools.pairwise(bounds):
             out, h_next = self.gru(feats[a:b], (h * keep[a]).unsqueeze(0))
             h = h_next.squeeze(0)
             outs.append(out)

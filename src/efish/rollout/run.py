@@ -148,7 +148,7 @@ class FoodLog:
         self.records: list[list] = []              # [episode, pellet id, x, y, t_spawned, t_eaten, eaten_by]
         self.slot = np.full(env.state.alive.shape, -1)  # record index currently in each slot
         self.count = np.zeros(env.state.alive.shape[0], int)  # pellets seen so far per episode
-        for b, k in zip(*np.nonzero(env.state.alive)):
+        for b, k in zip(*np.nonzero(env.state.alive), strict=True):
             self._spawn(env, b, k, 0)
 
     def _spawn(self, env: VecEnv, b: int, k: int, t: int) -> None:
@@ -163,11 +163,11 @@ class FoodLog:
         alive = env.state.alive
         alive_before = alive_before | ~running[:, None]  # ended arenas: nothing changes in the record
         alive = alive | ~running[:, None]
-        for b, i in zip(*np.nonzero(eaten_slot >= 0)):
+        for b, i in zip(*np.nonzero(eaten_slot >= 0), strict=True):
             if running[b]:
                 record = self.records[self.slot[b, eaten_slot[b, i]]]
                 record[5], record[6] = t, i
-        for b, k in zip(*np.nonzero(~alive_before & alive)):
+        for b, k in zip(*np.nonzero(~alive_before & alive), strict=True):
             self._spawn(env, b, k, t)
 
     def table(self) -> pd.DataFrame:

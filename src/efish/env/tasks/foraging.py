@@ -65,7 +65,7 @@ def foraging_rewards(cfg: EnvConfig, ate: np.ndarray, d_prev: np.ndarray, d_now:
     coef = foraging_coefficients(cfg) if coef is None else coef
     out = np.empty((len(FORAGING_PARTS),) + ate.shape)
     foraging_kernel(ate, d_prev, d_now, width, height, penalty_bitten, bit, collided, move, turn, coef, out)
-    return dict(zip(FORAGING_PARTS, out))
+    return dict(zip(FORAGING_PARTS, out, strict=True))
 
 
 class Foraging(Task):
