@@ -5,7 +5,7 @@ steps of seeded random actions (positions, headings, rewards, events and a
 per-agent summary of every observation). Regenerate it only for an intended
 change of behaviour, and say so in the commit:
 
-    python tests/env/test_recorded_trajectories.py --write
+    python tests/env/test_recorded_trajectories.py --write [NAME ...]
 """
 
 from __future__ import annotations
@@ -73,18 +73,29 @@ def test_trajectory_matches_the_record(name):
     assert set(got) == set(want)
     for key in ("terminated", "truncated", "ate", "bit", "eod", "collided"):
         np.testing.assert_array_equal(got[key], want[key], err_msg=f"{name}: {key}")
-    for key in ("xy", "heading", "reward", "obs_sum", "obs_abs"):
-        # bit-identical on the machine that recorded it; other CPUs may round kernels differently
+    for key in ("xy", "heading", "reward"):
+        # float64 state: bit-identical on the machine that recorded it; other CPUs may round kernels differently
         np.testing.assert_allclose(got[key], want[key], rtol=1e-9, atol=1e-9, err_msg=f"{name}: {key}")
+    for key in ("obs_sum", "obs_abs"):
+        # sums of up to 110 float32 observations: a CPU without AVX-512 rounds the float32 encoding differently
+        # (measured up to 1.2e-6 against a record made with AVX-512), far below any behavioural change
+        np.testing.assert_allclose(got[key], want[key], rtol=1e-6, atol=1e-5, err_msg=f"{name}: {key}")
 
 
-def write(path: Path = DATA) -> None:
-    """Record every config into ``path``."""
+def write(path: Path = DATA, names: list[str] | None = None) -> None:
+    """Record every config (or only ``names``, keeping the others' records) into ``path``."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    arrays = {f"{name}/{k}": v for name, overrides in CONFIGS.items() for k, v in record(overrides).items()}
-    np.savez_compressed(path, **arrays)
-    print(f"wrote {len(CONFIGS)} trajectories to {path}")
+    names = list(CONFIGS) if not names else names
+    kept = {}
+    if path.is_file():
+        with np.load(path) as old:
+            kept = {k: old[k] for k in old.files if k.split("/", 1)[0] not in names}
+    arrays = {f"{name}/{k}": v for name in names for k, v in record(CONFIGS[name]).items()}
+    np.savez_compressed(path, **kept, **arrays)
+    print(f"wrote {len(names)} trajectories to {path}")
 
 
 if __name__ == "__main__":
-    write(Path(sys.argv[2]) if len(sys.argv) > 2 else DATA) if "--write" in sys.argv else None
+    # python tests/env/test_recorded_trajectories.py --write [NAME ...]: every config, or only those named
+    if "--write" in sys.argv:
+        write(DATA, sys.argv[sys.argv.index("--write") + 1:])
