@@ -20,7 +20,7 @@ def test_the_training_log_never_prints_nan():
     assert "nan" not in log.line({"episode_return": -1.0, "episodes_ended": 1})
 
 
-# ------------------------------------------------- efish claims across seeds (CLAIMS.md rule 4)
+# ------------------------------------------------- efish claims across seeds
 def claims_rows(verdicts: dict[str, str]) -> pd.DataFrame:
     """A claims table (ROW_COLUMNS) with the given verdict per claim."""
     n = len(verdicts)

@@ -113,7 +113,7 @@ def _parser() -> argparse.ArgumentParser:
     cl.add_argument("--out", type=Path, help="folder for claims.parquet and claims.md (default <results>/claims)")
     cl.add_argument("--seed-claims", nargs="*", metavar="SEED=PATH",
                     help="the claims.parquet of each other top seed (results/{run}/seeds/seed_<n>/claims/): adds "
-                         "seed_verdicts and seeds_agree (CLAIMS.md rule 4); given with no value, the selected seed's "
+                         "seed_verdicts and seeds_agree; given with no value, the selected seed's "
                          "alone ('1/1 hold')")
     cl.add_argument("--ranking", type=Path,
                     help="the seed ranking, whose first row is the selected seed (default with --seed-claims: "

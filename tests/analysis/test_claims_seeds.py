@@ -1,4 +1,4 @@
-"""Verdicts across seeds (CLAIMS.md rule 4): seed_verdicts, seeds_agree and the flip sentence, on synthetic tables."""
+"""Verdicts across seeds: seed_verdicts, seeds_agree and the flip sentence, on synthetic tables."""
 
 from __future__ import annotations
 

@@ -204,7 +204,7 @@ def test_food_decoding_splits_at_the_near_distance_and_scores_only_where_the_sta
 
 
 def test_sensed_and_readout_targets_split_the_decoded_columns():
-    """CLAIMS rule 7: the policy's own outputs and size are readouts, never sensed competitors (claim C19)."""
+    """Decoding rule: the policy's own outputs and size are readouts, never sensed competitors (claim C19)."""
     assert set(SENSED_TARGETS).isdisjoint(READOUT_TARGETS)
     assert DECODE_TARGETS == {**SENSED_TARGETS, **READOUT_TARGETS}
     assert set(READOUT_TARGETS) == {"turn_rad", "eod", "size"}

@@ -44,7 +44,7 @@ def test_decoding_bars_are_the_scores_best_first_without_unscored_targets():
 
 @pytest.mark.parametrize("with_column", [True, False])
 def test_readouts_are_drawn_hatched_below_the_sensed_targets_and_not_ranked_among_them(with_column):
-    """CLAIMS rule 7: the own turn, EOD and size are drawn as readouts, after every sensed target, even when
+    """Decoding rule: the own turn, EOD and size are drawn as readouts, after every sensed target, even when
     they score best; a table without the readout column (an earlier run) is marked by target."""
     table = pd.DataFrame({"condition": "control", "target": ["turn_rad", "dist_agent_cm", "eod", "dist_wall_cm"],
                           "readout": [True, False, True, False], "score": [0.8, 0.3, 0.6, 0.1], "reason": ""})

@@ -1,5 +1,5 @@
 """The hidden table's rows are paired with the world they have observed, never with the action they produced
-(CLAIMS rule 7); and the decoding targets the rollout records for that pairing (SPEC "Decoding variables")."""
+(decoding rule: sensed variables only, README "Claims"); and the decoding targets the rollout records for that pairing."""
 
 from __future__ import annotations
 

@@ -133,7 +133,7 @@ def dry_run(work: Path, *args: str) -> subprocess.CompletedProcess:
                            "--directory", str(work), *args], capture_output=True, text=True, timeout=300)
 
 
-#: The verdicts of CLAIMS.md, and how seeds_agree counts them ("2/2 hold", "1/2 hold, 1/2 weaker (seed 1: ...)").
+#: The claims' verdicts, and how seeds_agree counts them ("2/2 hold", "1/2 hold, 1/2 weaker (seed 1: ...)").
 VERDICTS = {"holds", "weaker", "fails", "not decidable", "not run"}
 COUNT = r"\d+/\d+ (hold|weaker|fail|not decidable)"
 SEEDS_AGREE = re.compile(rf"not run \(0/\d+ seeds ran\)|{COUNT}(, {COUNT})*"
@@ -176,7 +176,7 @@ def test_the_other_top_seeds_rerun_the_claims_assays_for_their_own_claims(tmp_pa
 
 @pytest.mark.slow
 def test_the_claims_carry_the_verdicts_of_the_top_seeds(smoke_run):
-    """The smoke DAG's claims table has seed_verdicts and seeds_agree and only the verdicts of CLAIMS.md (the smoke
+    """The smoke DAG's claims table has seed_verdicts and seeds_agree and only the claims' verdicts (the smoke
     scale runs top_seeds 1; the other seeds' reruns are the dry run above and tests/analysis/test_claims_seeds.py)."""
     run = smoke_run / "results/smoke"
     claims = pd.read_parquet(run / "claims/claims.parquet")

@@ -42,7 +42,7 @@ use rule assay as assay_with_hidden with:
 # checkpoint as the `selected` policy, into results/{run}/seeds/seed_{seed}/assays/{assay}/ (the layout of
 # results/{run}/assays/): every top seed runs scale.top_seed_assays for the supplement's top-seed panels, and each
 # top seed other than the selected one also runs every claim's assay (common.smk: SEED_CLAIM_ASSAYS) for its own
-# claims table (CLAIMS.md rule 4). The selected seed's rules, whose inputs (assay_policies_input) read {seed}.
+# claims table. The selected seed's rules, whose inputs (assay_policies_input) read {seed}.
 use rule assay as top_seed_assay with:
     output:
         steps="results/{run}/seeds/seed_{seed}/assays/{assay}/steps.parquet",

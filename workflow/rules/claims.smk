@@ -1,7 +1,7 @@
 # Claims (CLAIMS.md): one job reading every table the claims registry (efish.analysis.claims.CLAIMS) names that
 # this scale produces, writing results/{run}/claims/claims.parquet and claims.md. A claim whose tables the scale
 # does not produce is written as "not run" with the missing table named (efish claims never fails on it).
-# Verdicts across seeds (CLAIMS.md, 4th rule). Each top seed other than the selected one gets its own claims table
+# Verdicts across seeds. Each top seed other than the selected one gets its own claims table
 # from its rerun assays (top_seed_claims, results/{run}/seeds/seed_{seed}/claims/); the claims job adds their
 # verdicts to the selected seed's as seed_verdicts and seeds_agree ("3/3 hold"), in the ranking's order.
 

@@ -109,7 +109,7 @@ def claims_read(names):
     return [path for path in claim_tables() if path in produced]
 
 
-# Verdicts across seeds (rule 4 of CLAIMS.md). Each top seed other than the selected one reruns every claim's assay,
+# Verdicts across seeds. Each top seed other than the selected one reruns every claim's assay,
 # i.e. every assay of the scale that some claim reads and whose conditions act (at least in part) with the selected
 # policy, into results/{run}/seeds/seed_{n}/ with the layout of results/{run}/, and only the analyses the claims
 # read. An assay acted only by recipe policies (homing) gives the same tables for every seed: not rerun; its claims

@@ -496,7 +496,7 @@ def paired_difference(ctx: Context, long: pd.DataFrame, better: str, worse: str,
     return from_row(row, sign, ctx.ci(diff, median_minus("diff", 0.0), strata=None))
 
 
-# ------------------------------------------------- paired and equivalence parts (CLAIMS rules 2, 3, 5)
+# ------------------------------------------------- paired and equivalence parts (paired tests, equivalence, ceilings)
 def margin_for(ctx: Context, control: np.ndarray, other: np.ndarray) -> tuple[float, str]:
     """The equivalence margin of an "n.s." part from the config (:func:`efish.analysis.claim_stats.equivalence_margin`)."""
     a = ctx.cfg.analysis
@@ -507,7 +507,7 @@ def margin_for(ctx: Context, control: np.ndarray, other: np.ndarray) -> tuple[fl
 
 def paired_part(ctx: Context, summary: pd.DataFrame, measure: str, condition: str, control: str,
                 sign: int, family: Iterable[str] | None = None) -> Outcome:
-    """``condition`` vs ``control`` paired over their shared episodes (rule 2): Wilcoxon signed-rank, Holm-adjusted
+    """``condition`` vs ``control`` paired over their shared episodes: Wilcoxon signed-rank, Holm-adjusted
     over ``family`` (default: every condition of ``summary``) compared with the same control; effect = median paired
     difference with a bootstrap interval over episodes. For ``sign`` 0 also the paired TOST within the margin."""
     present(summary, "condition", [condition, control], f"episodes with {measure}")
@@ -531,7 +531,7 @@ def paired_part(ctx: Context, summary: pd.DataFrame, measure: str, condition: st
 
 
 def unpaired_equivalence(ctx: Context, frame: pd.DataFrame, value: str, group: str, a, b) -> Outcome:
-    """Mann-Whitney of ``value``, ``a`` vs ``b`` (the control), and the unpaired TOST within the margin (rule 3)."""
+    """Mann-Whitney of ``value``, ``a`` vs ``b`` (the control), and the unpaired TOST within the margin."""
     out = mann_whitney_part(ctx, frame, value, group, a, b, 0)
     x, c = (frame.loc[frame[group] == g, value].to_numpy(np.float64) for g in (a, b))
     margin, how = margin_for(ctx, c, x)
@@ -540,7 +540,7 @@ def unpaired_equivalence(ctx: Context, frame: pd.DataFrame, value: str, group: s
 
 
 def ceiling(ctx: Context, summary: pd.DataFrame, food: pd.DataFrame, conditions: Iterable[str]) -> Outcome | None:
-    """A "not decidable" outcome when one of ``conditions`` ate every pellet in most episodes (rule 5), else None."""
+    """A "not decidable" outcome when one of ``conditions`` ate every pellet in most episodes (a ceiling), else None."""
     share = ctx.cfg.analysis.claims_ceiling_share
     for condition in conditions:
         full, how = at_ceiling(summary, food, condition, share)

@@ -1,4 +1,4 @@
-"""The statistics the claims' revised rules need (CLAIMS rules 1-7) that no analysis table holds.
+"""The statistics the claims' revised rules need (README, "Claims") that no analysis table holds.
 
 - :func:`paired_vs_control`: every condition against a control, paired over
   the episodes they share (Wilcoxon signed-rank), Holm-corrected over the
@@ -17,7 +17,7 @@
   shares is about (n - 1) / (2F) for large F: a condition that eats less looks
   more unequal by chance alone.
 - :func:`at_ceiling`: whether a condition eats every pellet there is, so no
-  food difference can appear (rule 5).
+  food difference can appear.
 - :func:`interaction_slope`: the difference of two OLS slopes (the N x K
   interaction of C17) with its t-test.
 """
@@ -69,7 +69,7 @@ def paired_vs_control(summary: pd.DataFrame, measure: str, control: str, conditi
 
 # ------------------------------------------------------------------ equivalence
 def equivalence_margin(control: np.ndarray, pooled_sd: float, fraction: float, sd_fraction: float) -> tuple[float, str]:
-    """The equivalence margin of an "n.s." part (CLAIMS rule 3) and how it was chosen.
+    """The equivalence margin of an "n.s." part and how it was chosen.
 
     ``fraction`` of the control's median, unless that median is near 0 (within
     one pooled SD of it, where a relative margin shrinks to nothing): then
@@ -150,7 +150,7 @@ def null_theil(total: int, agents: int, draws: int = 2000, seed: int = 0) -> flo
 
 
 def excess_theil(foods: Sequence[float]) -> float:
-    """Theil T of one episode's per-agent food minus its equal-share multinomial null at the same total (rule 6);
+    """Theil T of one episode's per-agent food minus its equal-share multinomial null at the same total;
     NaN when nothing was eaten."""
     f = np.asarray(foods, np.float64)
     total = int(round(f.sum()))
@@ -177,7 +177,7 @@ def eaten_fraction(summary: pd.DataFrame, food: pd.DataFrame, eaten: str = "food
 
 
 def at_ceiling(summary: pd.DataFrame, food: pd.DataFrame, condition: str, share: float) -> tuple[bool, str]:
-    """Whether ``condition`` ate every pellet there was in at least ``share`` of its episodes (rule 5), and a
+    """Whether ``condition`` ate every pellet there was in at least ``share`` of its episodes (a ceiling), and a
     sentence saying how often it did."""
     frac = eaten_fraction(summary, food)
     mine = frac.xs(condition, level="condition").dropna() if condition in frac.index.get_level_values(0) else frac[:0]

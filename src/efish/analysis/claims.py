@@ -372,7 +372,7 @@ def _confronting(ctx: Context) -> Outcome:
     if "confronting" not in pooled.index or len(pooled) < 2:
         raise ValueError("no confronting pair-step, or no other class, within range")
     other = (pooled["bites"] / pooled["n_steps"]).drop("confronting").idxmax()
-    # episodes where both classes occur within range: each episode is one paired unit (rule 1)
+    # episodes where both classes occur within range: each episode is one paired unit, never pooled steps
     both = per[per["label"].isin(["confronting", other])]
     both = both[both.groupby("episode")["label"].transform("nunique") == 2]
     out = paired_difference(ctx, both, "confronting", other, value="rate", key="label", unit="episode")
@@ -409,7 +409,7 @@ def c17(ctx: Context) -> list[Part]:
         return one_sample_part(ctx, dims, "fraction", a.claims_deff_fraction, -1)
 
     def per_episode() -> pd.DataFrame:
-        """D_eff averaged over the agents of each groupsize episode (rule 1: the episode is the unit)."""
+        """D_eff averaged over the agents of each groupsize episode (the episode is the unit)."""
         dims = groupsize_parts(ctx.table(analysis_table("dynamics", "groupsize", "dimensionality")))
         return (dims.groupby(["condition", "episode", "n_agents", "knollenorgans"], as_index=False)["d_eff"].mean()
                 .dropna(subset=["d_eff"]))
@@ -456,7 +456,7 @@ def c18(ctx: Context) -> list[Part]:
                      "train mean) of err_knollen minus bearing to the target; Wilcoxon", compute)]
 
 
-#: Fig 6E's sensed variables (CLAIMS rule 7: never the policy's own outputs or the agent's constant size), and
+#: Fig 6E's sensed variables (decoding rule: never the policy's own outputs or the agent's constant size), and
 #: among them the agent and Knollenorgan features the paper finds best.
 SENSED = {"dist_agent_cm": False, "knollen_spikes": False, "n_agents_100cm": False, "log_morm_sensed": False,
           "dist_wall_cm": False}

@@ -3,10 +3,10 @@
 Registered in :data:`efish.analysis.claim_parts.CLAIMS` on import
 (:mod:`efish.analysis.claims` imports this module). Conditions of one assay
 share their episode seeds, so they are compared paired over episodes with a
-Holm correction over the conditions compared with the same control (CLAIMS
-rule 2); "no difference" parts are equivalence tests (rule 3); food parts are
-not decidable while the control eats every pellet (rule 5); Theil T is
-compared above its equal-share null where totals differ (rule 6).
+Holm correction over the conditions compared with the same control; "no
+difference" parts are equivalence tests; food parts are not decidable while
+the control eats every pellet; Theil T is compared above its equal-share null
+where totals differ (the rules are listed in the README, "Claims").
 
 Condition names are those of ``config/assay/<assay>.yaml``.
 """
@@ -49,7 +49,7 @@ def summary(ctx: Context, assay: str) -> pd.DataFrame:
 def _vs_control(ctx: Context, assay: str, condition: str, control: str, measure: str, sign: int,
                 family: list[str] | None = None) -> Outcome:
     """A paired part of ``assay``; a food part is not decidable when the control is at a ceiling, a bites part
-    when neither condition bit at all (rule 5)."""
+    when neither condition bit at all (a floor)."""
     s = summary(ctx, assay)
     if family is not None:
         s = s[s["condition"].isin([*family, control])]
@@ -119,7 +119,7 @@ NPATCH = re.compile(r"(iso|free)_(\d+)$")  # config/assay/npatch.yaml
 
 
 def _episode_theil(ctx: Context, assay: str) -> pd.DataFrame:
-    """Excess Theil T of every episode of ``assay`` (rule 6), with its summary columns."""
+    """Excess Theil T of every episode of ``assay`` (totals differ), with its summary columns."""
     per_agent = ctx.table(analysis_table("behaviour", assay, "food_per_agent"))
     return summary(ctx, assay).merge(excess_theil_per_episode(per_agent), on=["condition", "episode"])
 

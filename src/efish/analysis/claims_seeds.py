@@ -1,4 +1,4 @@
-"""Verdicts across seeds (CLAIMS.md rule 4): the selected seed's claims table with how the other top seeds judged.
+"""Verdicts across seeds: the selected seed's claims table with how the other top seeds judged.
 
 One seed at a few episodes per condition cannot carry a verdict alone, so the
 pipeline computes every claim for the selected seed and for each of the other
@@ -35,7 +35,7 @@ import pandas as pd
 
 __all__ = ["SEED_COLUMNS", "VERDICTS", "agreement", "flip_sentence", "with_seed_verdicts"]
 
-#: The verdicts of CLAIMS.md, in the order counts are listed.
+#: The claims' verdicts, in the order counts are listed.
 VERDICTS = ("holds", "weaker", "fails", "not decidable", "not run")
 #: The columns :func:`with_seed_verdicts` adds, right after ``verdict``.
 SEED_COLUMNS = ("seed_verdicts", "seeds_agree")

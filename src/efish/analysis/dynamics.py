@@ -21,14 +21,14 @@ from sklearn.model_selection import GroupKFold, cross_val_predict
 from ._tables import AGENT_EPISODE, DEFAULTS, EPISODE, RATE_HZ, nan_frame, require
 
 SUBSAMPLE_FRACTIONS = tuple(DEFAULTS.subsample_fractions)
-#: Steps columns of the world the hidden state has observed (SPEC "Decoding variables (revised)", Fig 6E's sensed
+#: Steps columns of the world the hidden state has observed (README "Tables", Fig 6E's sensed
 #: variables) -> circular (radians) or not: the only competitors when decoding scores are ranked (claim C19).
 #: Each describes the world after step t, which the hidden row t has taken in (efish.rollout.run.hidden_table).
 SENSED_TARGETS = {"dist_agent_cm": False, "n_agents_100cm": False, "log_morm_sensed": False, "dist_wall_cm": False,
                   "bearing_agent_rad": True, "dist_agent2_cm": False, "size_agent1": False, "size_agent2": False,
                   "dist_food_cm": False, "bearing_food_rad": True, "bearing_wall_rad": True,
                   "food_count_5cm": False, "log_amp_field": False}
-#: Steps columns that are readouts of the policy itself, not sensing (CLAIMS rule 7): its own outputs of step t
+#: Steps columns that are readouts of the policy itself, not sensing (README, "Claims"): its own outputs of step t
 #: (the realised turn, the EOD: produced by the state before row t's, and fed back to row t's state through the
 #: observation's last-action tail) and the agent's own size, a per-agent constant of every observation. Decoded and
 #: reported, never ranked among the sensed targets.

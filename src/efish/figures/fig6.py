@@ -53,7 +53,7 @@ TARGET_LABELS = {
     "turn_rad": "turn", "log_morm_field": "log field (M, geometric)", "log_morm_sensed": "log reading (M, sensed)",
     "log_amp_field": "log field (A)",
 }
-#: Appended to the label of a readout target (the policy's own output or size, CLAIMS rule 7).
+#: Appended to the label of a readout target (the policy's own output or size).
 READOUT_SUFFIX = " (readout)"
 READOUT_HATCH = "////"
 POWER_LABEL = "wideband power (1/Hz)"
@@ -120,7 +120,7 @@ def subsampling_curves(tables: Tables, ax) -> None:
 
 
 def readout_rows(decoding: pd.DataFrame) -> pd.Series:
-    """Which rows of a decoding table are readouts of the decoded vector (CLAIMS rule 7): its ``readout`` column,
+    """Which rows of a decoding table are readouts of the decoded vector (README, "Claims"): its ``readout`` column,
     or, in a table written before that column existed, membership of efish.analysis.dynamics.READOUT_TARGETS."""
     if "readout" in decoding.columns:
         return decoding["readout"].fillna(False).astype(bool)
@@ -135,7 +135,7 @@ def decoding_bars(assay: str, title: str, control: str | None = None):
     first condition, grey).
 
     The sensed targets are ranked, best on top; the readouts (the policy's own
-    turn and EOD, its own size: not sensing, CLAIMS rule 7) are not ranked
+    turn and EOD, its own size: not sensing) are not ranked
     among them: they follow below a dashed line, hatched, labelled "(readout)".
     """
     def draw(tables: Tables, ax) -> None:
@@ -328,7 +328,7 @@ PANELS = [
           "analysis/dynamics/wide2/decoding. Each state is decoded against the world it has observed (the step's "
           "observation it has taken in). The sensed variables are ranked best first; the readouts of the decoded "
           "vector itself (the agent's own turn and EOD, fed back in its observation, and its own size) are drawn "
-          "hatched below the dashed line and not ranked (CLAIMS rule 7). Targets without a score are left out."),
+          "hatched below the dashed line and not ranked (decode only sensed variables). Targets without a score are left out."),
     Panel("fig6", "F", food_decoding_bars, {"food_decoding": _dyn("wide2", "food_decoding")},
           "Decoding score of the food variables (distance and bearing of the nearest pellet) from the hidden states "
           "of the wide2 agents on the steps with that pellet within analysis.claims_food_near_cm (near, in receptor "

@@ -97,10 +97,10 @@ def log_morm_sensed(morm_block: np.ndarray, e_min: float, e_max: float) -> np.nd
     """log10 (V/m) of the strongest Mormyromast reading each agent sensed, from its observation block [B, N, M].
 
     The reading is the one the channel delivers: after the baseline
-    subtraction of SPEC 3.1 (the own and conspecific direct EODs removed, so
+    subtraction (the own and conspecific direct EODs removed, so
     it holds the self image only when the agent emitted, and the gained
     conspecific image otherwise), with the sensor noise, clipped to
-    [``e_min``, ``e_max``]. The log normalisation of SPEC 3.4 is inverted:
+    [``e_min``, ``e_max``]. The log normalisation (efish.sensors.normalize) is inverted:
     log10 |s| = log10 e_min + |y| (log10 e_max - log10 e_min) where y != 0.
     NaN where no sensor reads above ``e_min`` (y = 0 everywhere: nothing is
     sensed, and the true value is only known to be below e_min; decoding drops

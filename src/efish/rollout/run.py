@@ -118,7 +118,7 @@ def hidden_table(keys: pd.DataFrame, hidden: np.ndarray) -> pd.DataFrame:
     returned (the world after step t, which the ``steps`` row t describes) and
     has produced none of row t's actions (those came from the state before).
     Merging ``hidden`` and ``steps`` on (condition, episode, t, agent) thus
-    pairs each state with the world it has observed (CLAIMS rule 7), never with
+    pairs each state with the world it has observed (README, "Claims"), never with
     the action it produced.
     """
     units = pd.DataFrame(hidden, columns=[f"h_{i}" for i in range(hidden.shape[1])])
