@@ -107,3 +107,76 @@ def test_compare_claims_shows_each_runs_seeds_agree_and_a_dash_without(tmp_path,
     header, row = capsys.readouterr().out.splitlines()
     assert "new seeds_agree" in header and "old seeds_agree" in header
     assert "2/2 hold" in row and " - " in row and row.rstrip().endswith("*")
+
+
+# ------------------------------------------------- dispatch: every (sub)command has a handler
+def _commands(parser) -> dict:
+    """{command: its parser} of every (sub)command, ``bench physics`` style for the nested ones."""
+    import argparse
+
+    found = {}
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for name, sub in action.choices.items():
+                nested = _commands(sub)
+                found.update({f"{name} {k}": v for k, v in nested.items()} if nested else {name: sub})
+    return found
+
+
+def test_every_command_has_a_handler_and_the_docstring_lists_it():
+    import efish.cli as cli
+
+    commands = _commands(cli._parser())
+    assert len(commands) == 23 and "bench scaling" in commands and "compare-claims" in commands
+    for name, parser in commands.items():
+        assert callable(parser.get_default("handler")), name
+    usage = {" ".join(line.split()[1:3]) if line.split()[1] == "bench" else line.split()[1]
+             for line in cli.__doc__.splitlines() if line.strip().startswith("efish ")}
+    assert usage == set(commands)
+
+
+@pytest.mark.parametrize("argv, listed", [
+    (["--help"], ["config", "train", "assay", "figure", "claims", "compare-claims", "plan-cluster", "bench"]),
+    (["bench", "--help"], ["physics", "env", "train", "budget", "pipeline", "accuracy", "scaling", "multipole"]),
+])
+def test_help_lists_every_subcommand(argv, listed, capsys):
+    with pytest.raises(SystemExit) as stop:
+        main(argv)
+    assert stop.value.code == 0
+    out = capsys.readouterr().out
+    assert all(name in out for name in listed)
+
+
+@pytest.mark.parametrize("argv", [
+    ["config", "bench.nope=1"],
+    ["train", "train.lr=-1"],
+    ["figure", "fig3/M", "scale=nope"],
+    ["bench", "accuracy", "bench.repeats=0"],
+    ["bench", "scaling", "bench.nope=1"],
+    ["bench", "train", "bench.train_skip_below=2"],
+])
+def test_a_bad_override_is_one_line_exit_2_and_nothing_written(argv, tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("efish: error:") and len(err.splitlines()) == 1, err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_config_lists_the_bench_sizes(capsys):
+    assert main(["config", "bench.train_skip_below=0.5"]) == 0
+    out = capsys.readouterr().out
+    for key in ("env_envs: 16", "train_skip_below: 0.5", "budget_minutes:", "multipole_width_cm: 560.0"):
+        assert key in out
+
+
+def test_default_folders_are_the_runs(tmp_path, monkeypatch, capsys):
+    """A command without --results reads the run its scale and overrides name (efish.layout)."""
+    from efish.config import run_name
+
+    monkeypatch.chdir(tmp_path)
+    assert main(["bench", "pipeline", "scale=smoke"]) == 2
+    assert "results/smoke/benchmarks" in capsys.readouterr().err
+    assert main(["claims", "scale=smoke", "analysis.claims_resamples=20"]) == 2
+    run = run_name("smoke", ["analysis.claims_resamples=20"])
+    assert f"results folder results/{run} does not exist" in capsys.readouterr().err

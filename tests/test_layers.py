@@ -19,7 +19,7 @@ import efish
 
 PACKAGE = Path(efish.__file__).resolve().parent
 LAYERS = {
-    "__init__": 0, "_version": 0, "_numba_cache": 0, "_jit": 0, "io": 0, "config": 0,
+    "__init__": 0, "_version": 0, "_numba_cache": 0, "_jit": 0, "io": 0, "config": 0, "layout": 0,
     "physics": 1, "sensors": 2, "env": 3, "rl": 4, "rollout": 5, "analysis": 6, "figures": 7,
     "bench": 8, "cli": 8, "__main__": 9,
 }
@@ -67,6 +67,56 @@ def test_no_module_imports_a_layer_above_its_own():
             if target != "efish" and layer_of(target) > layer_of(here):
                 upward.append(f"{here} -> {target}")
     assert not upward, "imports from a lower layer to a higher one:\n" + "\n".join(upward)
+
+
+#: The config composer: what the layers that read a run's tables must not use (issue 26: the run is the contract).
+COMPOSER_MODULE = "efish.config.compose"
+COMPOSER_NAMES = {"compose", "compose_variants"}
+
+
+def composer_uses(name: str, source: str, package: bool = False) -> list[str]:
+    """Where module ``name`` (``source``; ``package``: an ``__init__``) imports the config composer
+    (efish.config.compose, or compose / compose_variants from efish.config) or calls a function named compose or
+    compose_variants, as ``line: what``."""
+    here = name if package else name.rsplit(".", 1)[0]
+    found = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Import):
+            found += [f"{node.lineno}: import {a.name}" for a in node.names if a.name == COMPOSER_MODULE]
+        elif isinstance(node, ast.ImportFrom):
+            parts = here.split(".")
+            base = ".".join(parts[: len(parts) - node.level + 1] + ([node.module] if node.module else [])) \
+                if node.level else node.module or ""
+            names = {a.name for a in node.names}
+            if base == COMPOSER_MODULE or (base == "efish.config" and names & COMPOSER_NAMES):
+                found.append(f"{node.lineno}: from {base} import {', '.join(sorted(names))}")
+        elif isinstance(node, ast.Call):
+            func = node.func
+            called = func.id if isinstance(func, ast.Name) else func.attr if isinstance(func, ast.Attribute) else ""
+            if called in COMPOSER_NAMES:
+                found.append(f"{node.lineno}: calls {called}")
+    return found
+
+
+@pytest.mark.parametrize("layer", ["figures", "analysis"])
+def test_table_readers_never_compose_a_config(layer):
+    """Panels, clips and analyses read the conditions the run recorded (conditions.parquet, efish.config.recorded),
+    never a config composed afresh without the run's overrides."""
+    uses = {module_name(p): u for p in sorted((PACKAGE / layer).rglob("*.py"))
+            if (u := composer_uses(module_name(p), p.read_text(), p.name == "__init__.py"))}
+    assert not uses, f"efish.{layer} composes configs: {uses}"
+
+
+@pytest.mark.parametrize("source", ["from ..config import compose\n", "from ..config.compose import config_dir\n",
+                                    "from efish.config import compose_variants\n", "import efish.config.compose\n",
+                                    "def f(config):\n    return config.compose(['a'])\n"])
+def test_the_composer_check_sees_every_way_in(source):
+    assert composer_uses("efish.figures.fig9", source)
+
+
+def test_the_composer_check_lets_the_recorded_configs_through():
+    assert not composer_uses("efish.figures.fig9", "from ..config.recorded import recorded_conditions\n"
+                                                   "from ..config.schema import EfishConfig\nfrom .. import layout\n")
 
 
 def test_every_top_level_module_has_a_layer():

@@ -4,11 +4,12 @@
     efish plan [overrides]                    which effects run, and why
     efish train [overrides] [--out D]         train one seed (checkpoint.pt, metrics.parquet, final.pt)
     efish assay [overrides] --policy P...     run an assay into steps/episodes/food(/hidden).parquet
-    efish schema steps|episodes|food|hidden   the columns of a rollout table and what they mean
+    efish schema steps|episodes|food|hidden|conditions   the columns of a rollout table and what they mean
     efish select --episodes F... --out D      rank seeds, write the ranking and the chosen seed
     efish stack-seeds --tables T... --ranking R --out F   the top seeds' tables as one, with seed and rank
     efish analyze NAME [overrides] --tables D --out D   one analysis of an assay's tables -> <table>.parquet
-    efish figure FIG[/PANEL] [overrides]      draw a panel (or a figure's page) from the result tables
+    efish figure FIG[/PANEL] [overrides]      draw a panel (or a figure's page) from the result tables;
+                                              bench/accuracy and bench/scaling redraw a benchmark's figure
     efish render assay=NAME [overrides] [--condition C] [--episode K] [--out F.gif|F.mp4] [--field]
                                               one episode of an assay as a clip, from its rollout tables
     efish contact-sheet [overrides] [--figures D] [--out F.png]   every panel's PNG as a thumbnail with its id
@@ -17,20 +18,24 @@
                                               other top seeds' claims tables, seed_verdicts and seeds_agree too
     efish compare-claims A B                  two runs' claim verdicts, seeds_agree and effects side by side
     efish scene NAME [overrides] --out D      field maps of config/scene/NAME.yaml -> D/NAME.parquet
-    efish bench physics [overrides] [--json]  sensing throughput, fast vs reference
-    efish bench accuracy [overrides] --out D  accuracy-vs-time study -> table + figure
-    efish bench scaling [overrides] --out D   cost per agent-step vs pellets and agents -> table + figure
+    efish bench physics [overrides] [--json] [--out D]   sensing throughput, fast vs reference
+    efish bench accuracy [overrides] [--out D] [--figures D]   accuracy-vs-time study -> table (--out, default
+                                              results/<run>/bench) and figure (--figures, default figures/<run>/bench)
+    efish bench scaling [overrides] [--out D] [--figures D]    cost per agent-step vs pellets and agents -> the
+                                              same: table and figure
     efish bench multipole [overrides] [--orders P ..] [--width CM]   would cell multipoles make the far field cheaper?
-    efish bench env [overrides] [--json]      env-only throughput, fast vs reference physics
-    efish bench train [overrides] [--json]    rollout/update speed, model-FLOP utilisation
-    efish bench budget [overrides] --minutes M fixed training time: wider net, more steps or more seeds?
+    efish bench env [overrides] [--envs N] [--steps N] [--json]   env-only throughput, fast vs reference physics
+    efish bench train [overrides] [--hidden W ..] [--json]   rollout/update speed, model-FLOP utilisation
+    efish bench budget [overrides] [--minutes M] [--hidden W ..] [--seeds N] [--jobs N] [--out D]
+                                              fixed training time: wider net, more steps or more seeds?
     efish bench pipeline [--results D]        time per rule family of a pipeline run (Snakemake benchmarks)
     efish plan-cluster [overrides]            every job of a scale (scale=paper) with runtime, memory, cores, vs the
                                               slurm profile (from the laptop run's benchmark files)
 
 Overrides are Hydra's ``key=value`` (``physics.image_order=2``) or group
-choices (``arena=patchy70``). Every error is one line on stderr, exit code 2,
-and nothing is written.
+choices (``arena=patchy70``). The benchmarks' sizes are ``bench.*`` fields
+(``efish config`` lists them); a bench command's flags override them for one
+run. Every error is one line on stderr, exit code 2, and nothing is written.
 """
 
 from __future__ import annotations
@@ -44,54 +49,80 @@ from datetime import datetime, timezone
 from pathlib import Path
 from typing import Sequence
 
-from .config import ConfigError, compose, to_yaml
+from .config import ConfigError, compose, run_name, to_yaml
+from .layout import (
+    BENCH,
+    CLAIMS_PAGE,
+    CLAIMS_TABLE,
+    CONTACT_SHEET,
+    RANKING,
+    SELECTED_SEED,
+    Run,
+    assay_folder,
+    scene_table,
+    seed_name,
+    training_folder,
+)
 
 
 def _parser() -> argparse.ArgumentParser:
+    """The command line; every (sub)command's parser sets ``handler``, the function :func:`main` calls."""
     p = argparse.ArgumentParser(prog="efish", description=__doc__.split("\n\n")[0],
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
     c = sub.add_parser("config", help="print the resolved config")
     c.add_argument("overrides", nargs="*")
+    c.set_defaults(handler=_config)
     pl = sub.add_parser("plan", help="print the effect plan of a scene")
     pl.add_argument("overrides", nargs="*")
+    pl.set_defaults(handler=_plan)
     tr = sub.add_parser("train", help="train one seed with recurrent MAPPO (resumes from a checkpoint in --out)")
     tr.add_argument("overrides", nargs="*")
-    tr.add_argument("--out", type=Path, help="output folder (default results/{scale}/train/seed_{seed})")
+    tr.add_argument("--out", type=Path, help="output folder (default results/{run}/train/seed_{seed})")
     tr.add_argument("--restart", action="store_true", help="discard a checkpoint in --out and start afresh")
+    tr.set_defaults(handler=_train)
     asy = sub.add_parser("assay", help="run an assay with a trained policy into Parquet tables")
     asy.add_argument("overrides", nargs="*")
     asy.add_argument("--policy", nargs="+", required=True, metavar="[NAME=]PATH",
                      help="training folder, final.pt or checkpoint.pt of each policy the conditions act with "
                           "(NAME: selected, homing, homing_raycast, ...; a bare PATH is the assay's own policy)")
-    asy.add_argument("--out", type=Path, help="output folder (default results/{scale}/assays/{assay})")
+    asy.add_argument("--out", type=Path, help="output folder (default results/{run}/assays/{assay})")
+    asy.set_defaults(handler=_assay)
     sch = sub.add_parser("schema", help="print the columns of a rollout table with their meaning")
-    sch.add_argument("table", choices=("steps", "episodes", "food", "hidden"))
+    sch.add_argument("table", choices=("steps", "episodes", "food", "hidden", "conditions"))
     sch.add_argument("overrides", nargs="*")
+    sch.set_defaults(handler=_schema)
     sel = sub.add_parser("select", help="rank seeds from their evaluation episodes (SPEC 10)")
     sel.add_argument("overrides", nargs="*", help="config overrides, recorded in config.yaml (e.g. scale=laptop)")
     sel.add_argument("--episodes", nargs="+", type=Path, required=True,
                      help="episodes.parquet files in folders named seed_<n>")
     sel.add_argument("--out", type=Path, required=True, help="folder for ranking.parquet and selected_seed.txt")
+    sel.set_defaults(handler=_select)
     st = sub.add_parser("stack-seeds", help="stack the top seeds' tables (each under seed_<n>/) into one table")
     st.add_argument("overrides", nargs="*")
     st.add_argument("--tables", nargs="+", type=Path, required=True, help="the seeds' tables, each under seed_<n>/")
-    st.add_argument("--ranking", type=Path, required=True, help="the seed ranking (analysis/selection/ranking.parquet)")
+    st.add_argument("--ranking", type=Path, required=True, help=f"the seed ranking ({RANKING})")
     st.add_argument("--out", type=Path, required=True, help="the stacked table (.parquet)")
+    st.set_defaults(handler=_stack_seeds)
     an = sub.add_parser("analyze", help="run one analysis (efish.analysis.registry) on an assay's rollout tables")
     an.add_argument("name", help="an analysis of efish.analysis.registry, e.g. behaviour (a wrong name lists them)")
     an.add_argument("overrides", nargs="*", help="config overrides, e.g. assay=patchy4 analysis.rate_bins=10")
     an.add_argument("--tables", type=Path, required=True, help="folder of the assay's tables (steps.parquet, ...)")
     an.add_argument("--out", type=Path, required=True, help="folder for <table>.parquet, config.yaml, provenance.json")
+    an.set_defaults(handler=_analyze)
     sc = sub.add_parser("scene", help="compute a scene's field maps (config/scene/<name>.yaml) into a table")
     sc.add_argument("name", help="a scene of config/scene/, e.g. eod_walls")
     sc.add_argument("overrides", nargs="*", help="config overrides, e.g. scene.resolution_cm=1")
-    sc.add_argument("--out", type=Path, help="folder for <name>.parquet (default results/{scale}/scenes)")
+    sc.add_argument("--out", type=Path, help="folder for <name>.parquet (default results/{run}/scenes)")
+    sc.set_defaults(handler=_scene)
     fg = sub.add_parser("figure", help="draw a panel (fig3/M) or a whole figure's page (fig3) from the tables")
-    fg.add_argument("key", help="panel id like fig3/M, or a figure id like fig3 for its page")
+    fg.add_argument("key", help="panel id like fig3/M, a figure id like fig3 for its page, or bench/accuracy, "
+                                "bench/scaling (a benchmark's figure, from results/{run}/bench/bench_<name>.parquet)")
     fg.add_argument("overrides", nargs="*")
-    fg.add_argument("--results", type=Path, help="folder of the result tables (default results/{scale})")
-    fg.add_argument("--out", type=Path, help="folder for the figures (default figures/{scale})")
+    fg.add_argument("--results", type=Path, help="folder of the result tables (default results/{run})")
+    fg.add_argument("--out", type=Path, help="folder for the figures (default figures/{run}; a benchmark's figure "
+                                             "goes to its bench/)")
+    fg.set_defaults(handler=_figure)
     rd = sub.add_parser("render", help="draw one episode of an assay as a clip (.gif; .mp4 with ffmpeg)")
     rd.add_argument("overrides", nargs="*", help="config overrides; assay=<name> names the assay (e.g. homing)")
     rd.add_argument("--condition", help="condition to draw (default: the assay's first)")
@@ -103,10 +134,12 @@ def _parser() -> argparse.ArgumentParser:
     rd.add_argument("--fps", type=float, help="frames per second (default env.fps / N: real time)")
     rd.add_argument("--field", action="store_true", help="overlay |E| of the EODs discharged at each step "
                                                          "(computed by the physics on a coarse grid)")
+    rd.set_defaults(handler=_render)
     cs = sub.add_parser("contact-sheet", help="every registered panel's PNG as a thumbnail with its id")
     cs.add_argument("overrides", nargs="*")
     cs.add_argument("--figures", type=Path, help="figure folder of the run (default figures/{run})")
-    cs.add_argument("--out", type=Path, help="the sheet, a .png (default <figures>/contact_sheet.png)")
+    cs.add_argument("--out", type=Path, help=f"the sheet, a .png (default <figures>/{CONTACT_SHEET})")
+    cs.set_defaults(handler=_contact_sheet)
     cl = sub.add_parser("claims", help="the claims of CLAIMS.md as verdicts from a run's tables")
     cl.add_argument("overrides", nargs="*", help="config overrides, e.g. scale=smoke analysis.claims_resamples=200")
     cl.add_argument("--results", type=Path, help="the run's results folder (default results/{run})")
@@ -116,12 +149,13 @@ def _parser() -> argparse.ArgumentParser:
                          "seed_verdicts and seeds_agree; given with no value, the selected seed's "
                          "alone ('1/1 hold')")
     cl.add_argument("--ranking", type=Path,
-                    help="the seed ranking, whose first row is the selected seed (default with --seed-claims: "
-                         "<results>/analysis/selection/ranking.parquet); alone it adds the seed columns too")
+                    help=f"the seed ranking, whose first row is the selected seed (default with --seed-claims: "
+                         f"<results>/{RANKING}); alone it adds the seed columns too")
+    cl.set_defaults(handler=_claims)
     cc = sub.add_parser("compare-claims", help="two runs' claim verdicts and effect sizes side by side")
     cc.add_argument("a", help="claims.parquet, a claims folder, or a run name (results/<name>/claims/claims.parquet)")
     cc.add_argument("b", help="the same for the second run")
-    cc.set_defaults(overrides=[])
+    cc.set_defaults(handler=_compare_claims)  # no overrides: nothing to compose
     pc = sub.add_parser("plan-cluster", help="expected runtime, memory and cores of every job of a scale, checked "
                                              "against a SLURM profile")
     pc.add_argument("overrides", nargs="*", help="the scale to plan and its overrides, e.g. scale=paper")
@@ -131,46 +165,59 @@ def _parser() -> argparse.ArgumentParser:
     pc.add_argument("--dry-run", type=Path, help="a saved `snakemake -n --forceall` output instead of running it")
     pc.add_argument("--json", action="store_true", help="print JSON records instead of a table")
     pc.add_argument("--suggest", action="store_true", help="also print set-resources covering the headroom")
-    b = sub.add_parser("bench", help="speed and accuracy studies")
+    pc.set_defaults(handler=_plan_cluster)
+    _bench_parsers(sub.add_parser("bench", help="speed and accuracy studies (sizes: the bench.* config fields)"))
+    return p
+
+
+def _bench_parsers(b: argparse.ArgumentParser) -> None:
+    """``efish bench <study>``: a flag left out means the config's ``bench.*`` value (one copy: the schema)."""
     bsub = b.add_subparsers(dest="bench", required=True)
     bp = bsub.add_parser("physics", help="sensing throughput: fast path vs reference, one thread")
     bp.add_argument("overrides", nargs="*")
     bp.add_argument("--json", action="store_true", help="print JSON instead of a table")
     bp.add_argument("--out", type=Path, help="also write bench_physics.json (+ config, provenance) here")
+    bp.set_defaults(handler=_bench_physics)
     be = bsub.add_parser("env", help="env-only throughput with random actions: fast path vs reference")
     be.add_argument("overrides", nargs="*")
     be.add_argument("--json", action="store_true", help="print JSON instead of a table")
-    be.add_argument("--envs", type=int, default=16, help="arenas stepped together (default 16)")
-    be.add_argument("--steps", type=int, default=100, help="timed steps (default 100)")
+    be.add_argument("--envs", type=int, help="arenas stepped together (default bench.env_envs)")
+    be.add_argument("--steps", type=int, help="timed steps (default bench.env_steps)")
+    be.set_defaults(handler=_bench_env)
     bt = bsub.add_parser("train", help="rollout/update speed and model-FLOP utilisation")
     bt.add_argument("overrides", nargs="*")
     bt.add_argument("--json", action="store_true", help="print JSON instead of a table")
-    bt.add_argument("--hidden", type=int, nargs="+", default=[512, 64], help="widths to time (default 512 64)")
+    bt.add_argument("--hidden", type=int, nargs="+", help="widths to time (default bench.train_hidden)")
+    bt.set_defaults(handler=_bench_train)
     bb = bsub.add_parser("budget", help="at fixed training time: a wider network, more env steps or more seeds")
     bb.add_argument("overrides", nargs="*")
-    bb.add_argument("--minutes", type=float, default=10.0, help="wall time of each run (default 10)")
-    bb.add_argument("--hidden", type=int, nargs="+", default=[64, 128], help="widths to train (default 64 128)")
-    bb.add_argument("--seeds", type=int, default=2, help="seeds per width (default 2)")
-    bb.add_argument("--jobs", type=int, default=2, help="runs at a time, one thread each (default 2)")
+    bb.add_argument("--minutes", type=float, help="wall time of each run (default bench.budget_minutes)")
+    bb.add_argument("--hidden", type=int, nargs="+", help="widths to train (default bench.budget_hidden)")
+    bb.add_argument("--seeds", type=int, help="seeds per width (default bench.budget_seeds)")
+    bb.add_argument("--jobs", type=int, help="runs at a time, one thread each (default bench.budget_jobs)")
     bb.add_argument("--out", type=Path, help="also write bench_budget.parquet (+ config, provenance) here")
+    bb.set_defaults(handler=_bench_budget)
     bpl = bsub.add_parser("pipeline", help="time per rule family of a finished pipeline run")
     bpl.add_argument("overrides", nargs="*")
-    bpl.add_argument("--results", type=Path, help="results folder of the run (default results/{scale})")
+    bpl.add_argument("--results", type=Path, help="results folder of the run (default results/{run})")
     bpl.add_argument("--json", action="store_true", help="print JSON records instead of a table")
-    ba = bsub.add_parser("accuracy", help="accuracy-vs-time sweep: table and figure")
-    ba.add_argument("overrides", nargs="*")
-    ba.add_argument("--out", type=Path, default=Path("results/bench"), help="output folder (default results/bench)")
-    ba.add_argument("--json", action="store_true", help="print the table as JSON records")
-    bs = bsub.add_parser("scaling", help="cost per agent-step against pellets and agents: table and figure")
-    bs.add_argument("overrides", nargs="*")
-    bs.add_argument("--out", type=Path, default=Path("results/bench"), help="output folder (default results/bench)")
-    bs.add_argument("--json", action="store_true", help="print the table as JSON records")
+    bpl.set_defaults(handler=_bench_pipeline)
+    for name, help_ in (("accuracy", "accuracy-vs-time sweep: table and figure"),
+                        ("scaling", "cost per agent-step against pellets and agents: table and figure")):
+        bf = bsub.add_parser(name, help=help_)
+        bf.add_argument("overrides", nargs="*")
+        bf.add_argument("--out", type=Path, help=f"folder for bench_{name}.parquet, config.yaml and provenance "
+                                                 "(default results/{run}/bench)")
+        bf.add_argument("--figures", type=Path, help=f"folder for bench_{name}.png and .pdf (default "
+                                                     "figures/{run}/bench)")
+        bf.add_argument("--json", action="store_true", help="print the table as JSON records")
+        bf.set_defaults(handler=_bench_accuracy if name == "accuracy" else _bench_scaling)
     bm = bsub.add_parser("multipole", help="cell multipoles against direct far-field reads at the plan's accuracy")
     bm.add_argument("overrides", nargs="*")
-    bm.add_argument("--orders", type=int, nargs="+", default=[4, 6, 8], help="expansion orders (default 4 6 8)")
-    bm.add_argument("--width", type=float, default=560.0, help="square arena side of the scene, cm (default 560)")
+    bm.add_argument("--orders", type=int, nargs="+", help="expansion orders (default bench.multipole_orders)")
+    bm.add_argument("--width", type=float, help="square arena side of the scene, cm (default bench.multipole_width_cm)")
     bm.add_argument("--json", action="store_true", help="print the table as JSON records")
-    return p
+    bm.set_defaults(handler=_bench_multipole)
 
 
 def _metadata(folder: Path, cfg, started, args, name: str = "provenance.json", **extra) -> None:
@@ -180,11 +227,9 @@ def _metadata(folder: Path, cfg, started, args, name: str = "provenance.json", *
     write_run_metadata(folder, to_yaml(cfg), started, {"overrides": list(args.overrides), **extra}, name=name)
 
 
-def _run_folder(cfg, args, root: str = "results") -> Path:
-    """Default output root of this command: ``results/<run>`` (the run named by the scale and overrides)."""
-    from .config import run_name
-
-    return Path(root) / run_name(cfg.scale.name, [o for o in args.overrides if not o.startswith("scale=")])
+def _run(cfg, overrides: Sequence[str]) -> Run:
+    """The run the scale and ``overrides`` name: the folders of a command's default outputs (:mod:`efish.layout`)."""
+    return Run(run_name(cfg.scale.name, [o for o in overrides if not o.startswith("scale=")]))
 
 
 def _progress(items: list, label: str, unit: str = "setting", every: int = 1):
@@ -219,7 +264,7 @@ class ReturnLog:
 def _train(args, cfg, started) -> None:
     from .rl.train import train
 
-    out = args.out or _run_folder(cfg, args) / "train" / f"seed_{cfg.train.seed}"
+    out = args.out or _run(cfg, args.overrides).path(training_folder(seed_name(cfg.train.seed)))
     bar = None
     if sys.stderr.isatty():
         from tqdm import tqdm
@@ -252,7 +297,7 @@ def _assay(args, cfg, started) -> None:
 
     paths = policy_paths(args.policy, cfg.assay.policy)
     policies = {name: load_policy(path) for name, path in paths.items()}
-    out = args.out or _run_folder(cfg, args) / "assays" / cfg.assay.name
+    out = args.out or _run(cfg, args.overrides).path(assay_folder(cfg.assay.name))
     tables, stats = run_assay(args.overrides, policies, progress=lambda c: print(f"condition {c} done",
                                                                                   file=sys.stderr, flush=True))
     write_tables(tables, out)
@@ -280,9 +325,9 @@ def _select(args, cfg, started) -> None:
     table, chosen = select_seed(args.episodes)
     if table["fallback"].any():
         print("efish: warning: no seed has a positive median intercept; ranked all seeds (fallback)", file=sys.stderr)
-    with atomic_path(args.out / "ranking.parquet") as tmp:
+    with atomic_path(args.out / Path(RANKING).name) as tmp:
         table.to_parquet(tmp, index=False)
-    write_text_atomic(args.out / "selected_seed.txt", f"{chosen}\n")
+    write_text_atomic(args.out / Path(SELECTED_SEED).name, f"{chosen}\n")
     _metadata(args.out, cfg, started, args, episodes=[str(p) for p in args.episodes])
     print(table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
     print(f"selected seed {chosen}")
@@ -316,7 +361,7 @@ def _scene(args, cfg, started) -> None:
     if scene_cfg.scene.name != args.name:
         raise ValueError(f"config/scene/{args.name}.yaml names its scene {scene_cfg.scene.name!r}: they must agree")
     table = build_scene(scene_cfg, args.overrides)
-    out = args.out or _run_folder(cfg, args) / "scenes"
+    out = args.out or _run(cfg, args.overrides).path(scene_table(args.name)).parent
     write_parquet_tables({args.name: to_arrow(table)}, out)
     # the folder holds every scene: one config (the run's) and one provenance per scene, with the scene resolved
     _metadata(out, cfg, started, args, name=f"{args.name}.provenance.json", scene=args.name,
@@ -329,10 +374,10 @@ def _claims(args, cfg, started) -> None:
     from .analysis.claims_report import claims_markdown
     from .io import write_parquet_tables, write_text_atomic
 
-    results = args.results or _run_folder(cfg, args)
+    results = args.results or _run(cfg, args.overrides).results
     if not results.is_dir():
         raise ValueError(f"results folder {results} does not exist")
-    out = args.out or results / "claims"
+    out = args.out or (results / CLAIMS_TABLE).parent
     seeds = _seed_claims(args, results)  # read before anything is computed or written
     table = claims_table(results, cfg)
     header = (f"Claims of the paper at scale {cfg.scale.name} (run {results.name}), "
@@ -343,14 +388,15 @@ def _claims(args, cfg, started) -> None:
         selected, others = seeds
         table = with_seed_verdicts(table, others, selected)
         header += f"; selected seed {selected}" + (f", other top seeds {', '.join(map(str, others))}" if others else "")
-    write_parquet_tables({"claims": table}, out)
-    write_text_atomic(out / "claims.md", claims_markdown(table, header))
+    table_path, page_path = out / Path(CLAIMS_TABLE).name, out / Path(CLAIMS_PAGE).name
+    write_parquet_tables({table_path.stem: table}, out)
+    write_text_atomic(page_path, claims_markdown(table, header))
     _metadata(out, cfg, started, args, results=str(results),
               **({} if seeds is None else {"selected_seed": seeds[0], "other_seeds": list(seeds[1])}))
     shown = ["claim", "panel", "effect", "ci_low", "ci_high", "n", "p", "verdict"]
     print(table[shown + ["seeds_agree"] * ("seeds_agree" in table.columns)].to_string(
         index=False, float_format=lambda v: f"{v:.3g}"))
-    print(f"wrote {out / 'claims.parquet'} and {out / 'claims.md'}")
+    print(f"wrote {table_path} and {page_path}")
 
 
 def _seed_claims(args, results: Path):
@@ -360,7 +406,7 @@ def _seed_claims(args, results: Path):
 
     if args.seed_claims is None and args.ranking is None:
         return None
-    ranking_path = args.ranking or results / "analysis" / "selection" / "ranking.parquet"
+    ranking_path = args.ranking or results / RANKING
     if not ranking_path.is_file():
         raise ValueError(f"no seed ranking at {ranking_path}: --seed-claims needs --ranking (its first row is the "
                          "selected seed)")
@@ -383,7 +429,7 @@ def _seed_claims(args, results: Path):
     return ranking[0], {s: read_parquet(paths[s], f"seed {s}'s claims table") for s in ordered}
 
 
-def _compare_claims(args) -> None:
+def _compare_claims(args, cfg, started) -> None:
     from .analysis.claims_report import compare_claims, load_claims
 
     (name_a, a), (name_b, b) = load_claims(args.a), load_claims(args.b)
@@ -391,23 +437,29 @@ def _compare_claims(args) -> None:
 
 
 def _figure(args, cfg, started) -> None:
+    from .bench.figures import NAMES as BENCH_FIGURES
+    from .bench.figures import redraw_bench_figure
     from .figures.registry import drawable, figures
-    from .figures.render import render_page, render_panel
+    from .figures.render import render_figure, render_panel
 
-    results = args.results or _run_folder(cfg, args)
-    out = args.out or _run_folder(cfg, args, root="figures")
-    if args.key == "bench/accuracy":
-        written = _accuracy_figure(results, out)
+    run = _run(cfg, args.overrides)
+    results = args.results or run.results
+    out = args.out or run.figures
+    if args.key.startswith(f"{BENCH}/"):
+        drawn = {args.key: redraw_bench_figure(args.key.split("/", 1)[1], results, out / BENCH)}
     elif "/" in args.key:
-        written = render_panel(args.key, results, out, cfg.scale.seeds)
-    else:
+        drawn = {args.key: render_panel(args.key, results, out, cfg.scale.seeds)}
+    else:  # a figure: each of its panels and its page, from one reading of the tables
         if args.key not in figures():
-            raise ValueError(f"unknown figure {args.key!r}: choose one of {', '.join(figures())}, bench/accuracy")
+            raise ValueError(f"unknown figure {args.key!r}: choose one of {', '.join(figures())}, "
+                             f"{', '.join(f'{BENCH}/{n}' for n in BENCH_FIGURES)}")
         panels = [p for p in drawable(cfg.scale) if p.figure == args.key]
-        written = render_page(args.key, panels, results, out, cfg.scale.seeds)
+        drawn = render_figure(args.key, panels, results, out, cfg.scale.seeds)
     # one provenance per drawn output (a figure folder holds many panels), one config per folder
-    _metadata(written[0].parent, cfg, started, args, name=f"{written[0].stem}.provenance.json", figure=args.key,
-              results=str(results))
+    for key, files in drawn.items():
+        _metadata(files[0].parent, cfg, started, args, name=f"{files[0].stem}.provenance.json", figure=key,
+                  results=str(results))
+    written = [path for files in drawn.values() for path in files]
     print("wrote " + ", ".join(map(str, written)))
 
 
@@ -415,9 +467,9 @@ def _render(args, cfg, started) -> None:
     from .figures.episode import clip_writer, load_episode, render_clip
 
     # assay= picks the tables, not the run: the default folders are the run's (results/smoke for scale=smoke)
-    run = argparse.Namespace(overrides=[o for o in args.overrides if not o.startswith("assay=")])
-    tables = args.tables or _run_folder(cfg, run) / "assays" / cfg.assay.name
-    out = args.out or _run_folder(cfg, run, root="figures") / "clips" / f"{cfg.assay.name}.gif"
+    run = _run(cfg, [o for o in args.overrides if not o.startswith("assay=")])
+    tables = args.tables or run.path(assay_folder(cfg.assay.name))
+    out = args.out or run.clip(cfg.assay.name)
     clip_writer(out)  # a wrong suffix, or .mp4 without ffmpeg, fails before any table is read
     episode = load_episode(tables, args.overrides, cfg, args.condition, args.episode)
     frames = render_clip(episode, out, every=args.every, fps=args.fps, field=args.field,
@@ -431,42 +483,51 @@ def _render(args, cfg, started) -> None:
 def _contact_sheet(args, cfg, started) -> None:
     from .figures.contact_sheet import write_contact_sheet
 
-    figures = args.figures or _run_folder(cfg, args, root="figures")
-    out = args.out or figures / "contact_sheet.png"
+    figures = args.figures or _run(cfg, args.overrides).figures
+    out = args.out or figures / CONTACT_SHEET
     drawn, absent = write_contact_sheet(figures, out)
     _metadata(out.parent, cfg, started, args, name=f"{out.stem}.provenance.json", figures=str(figures))
     print(f"wrote {out} (panels drawn: {drawn}; not drawn at this scale: {absent})")
 
 
-def _accuracy_figure(results: Path, out: Path) -> list[Path]:
-    """The accuracy-vs-time figure (PNG and PDF) from ``results/bench/bench_accuracy.parquet``."""
-    from .bench.accuracy import plot_accuracy
-    from .io import atomic_path, read_parquet
-
-    table = results / "bench" / "bench_accuracy.parquet"
-    if not table.is_file():
-        raise ValueError(f"the accuracy figure needs {table}, which does not exist (run efish bench accuracy first)")
-    df = read_parquet(table, "the accuracy table")
-    written = []
-    for ext in ("png", "pdf"):
-        path = out / "bench" / f"bench_accuracy.{ext}"
-        with atomic_path(path) as tmp:
-            plot_accuracy(df, tmp)
-        written.append(path)
-    return written
-
-
-def _plan_cluster(args) -> None:
+def _plan_cluster(args, cfg, started) -> None:
     from .bench.cluster import format_plan, plan_cluster, suggested_resources
 
     text = args.dry_run.read_text() if args.dry_run else None
-    checked = plan_cluster(args.overrides, args.source, args.results or Path("results") / args.source, args.profile,
-                           text)
+    checked = plan_cluster(args.overrides, args.source, args.results or Run(args.source).results, args.profile, text)
     print(checked.to_json(orient="records", indent=1) if args.json else format_plan(checked))
     if args.suggest:
         import yaml
 
         print(yaml.safe_dump({"set-resources": suggested_resources(checked)}, sort_keys=True), end="")
+
+
+def _config(args, cfg, started) -> None:
+    print(to_yaml(cfg), end="")
+
+
+def _schema(args, cfg, started) -> None:
+    from .rollout.schema import describe
+
+    print(describe(args.table))
+
+
+def _plan(args, cfg, started) -> None:
+    from .env.vec_env import scene_of
+    from .physics.plan import build_plan
+
+    print(build_plan(cfg, scene_of(cfg)).explain())
+
+
+def _stderr(line: str) -> None:
+    print(line, file=sys.stderr, flush=True)
+
+
+def _with_bench(cfg, **flags):
+    """``cfg`` with the ``bench.*`` fields a bench command's flags set (a flag left out, None, keeps the config's),
+    so the config.yaml written beside an output records what ran."""
+    changes = {k: v for k, v in flags.items() if v is not None}
+    return dataclasses.replace(cfg, bench=dataclasses.replace(cfg.bench, **changes)) if changes else cfg
 
 
 def _bench_physics(args, cfg, started) -> None:
@@ -480,16 +541,31 @@ def _bench_physics(args, cfg, started) -> None:
         _metadata(args.out, cfg, started, args)
 
 
+def _bench_env(args, cfg, started) -> None:
+    from .bench.env import bench_env, format_env
+
+    rows = bench_env(_with_bench(cfg, env_envs=args.envs, env_steps=args.steps))
+    print(json.dumps(rows, indent=2) if args.json else format_env(rows))
+
+
+def _bench_train(args, cfg, started) -> None:
+    from .bench.train import bench_train, format_train
+
+    rows = bench_train(_with_bench(cfg, train_hidden=args.hidden), progress=lambda line: _stderr(f"bench train: {line}"))
+    print(json.dumps(rows, indent=2) if args.json else format_train(rows))
+
+
 def _bench_budget(args, cfg, started) -> None:
-    from .bench.budget import bench_budget, check_budget, format_budget
+    from .bench.budget import bench_budget, budget_sizes, format_budget
     from .io import atomic_path
 
-    check_budget(tuple(args.hidden), args.seeds, args.minutes, args.jobs)  # before announcing the runs
-    runs = len(args.hidden) * args.seeds
-    print(f"bench budget: {runs} runs of {args.minutes:g} min, {args.jobs} at a time: about "
-          f"{args.minutes * -(-runs // args.jobs):.0f} min", file=sys.stderr, flush=True)
-    table = bench_budget(cfg, tuple(args.hidden), args.seeds, args.minutes, args.jobs,
-                         progress=lambda run: print(f"budget: {run} done", file=sys.stderr, flush=True))
+    cfg = _with_bench(cfg, budget_minutes=args.minutes, budget_hidden=args.hidden, budget_seeds=args.seeds,
+                      budget_jobs=args.jobs)
+    hiddens, seeds, minutes, jobs = budget_sizes(cfg)  # checked before announcing the runs
+    runs = len(hiddens) * seeds
+    _stderr(f"bench budget: {runs} runs of {minutes:g} min, {jobs} at a time: about "
+            f"{minutes * -(-runs // jobs):.0f} min")
+    table = bench_budget(cfg, progress=lambda run: _stderr(f"budget: {run} done"))
     if args.out:
         with atomic_path(args.out / "bench_budget.parquet") as tmp:
             table.to_parquet(tmp, index=False)
@@ -497,112 +573,70 @@ def _bench_budget(args, cfg, started) -> None:
     print(format_budget(table))
 
 
-def _bench_accuracy(args, cfg, started) -> None:
-    from .bench.accuracy import bench_accuracy, plot_accuracy
+def _bench_pipeline(args, cfg, started) -> None:
+    from .bench.pipeline import format_timings, pipeline_timings
+
+    table = pipeline_timings(args.results or _run(cfg, args.overrides).results)
+    print(table.to_json(orient="records", indent=1) if args.json else format_timings(table))
+
+
+def _bench_multipole(args, cfg, started) -> None:
+    from .bench.multipole import bench_multipole, format_multipole
+
+    table = bench_multipole(_with_bench(cfg, multipole_orders=args.orders, multipole_width_cm=args.width))
+    print(table.to_json(orient="records", indent=1) if args.json else format_multipole(table))
+
+
+def _bench_with_figure(name: str, df, args, cfg, started) -> tuple[Path, list[Path]]:
+    """Write a benchmark's table (+ config, provenance) to ``--out`` and its figure (PNG, PDF, each with config and
+    provenance) to ``--figures``, by default the run's ``results/<run>/bench`` and ``figures/<run>/bench``."""
+    from .bench.figures import draw_bench_figure, stem
     from .io import atomic_path
 
-    df = bench_accuracy(cfg, progress=lambda s: _progress(s, "accuracy"))
-    args.out.mkdir(parents=True, exist_ok=True)
-    with atomic_path(args.out / "bench_accuracy.parquet") as tmp:
+    run = _run(cfg, args.overrides)
+    out, figures = args.out or run.bench, args.figures or run.bench_figures
+    table = out / f"{stem(name)}.parquet"
+    with atomic_path(table) as tmp:
         df.to_parquet(tmp, index=False)
-    for ext in ("png", "pdf"):
-        with atomic_path(args.out / f"bench_accuracy.{ext}") as tmp:
-            plot_accuracy(df, tmp)
-    _metadata(args.out, cfg, started, args)
+    _metadata(out, cfg, started, args, name=f"{stem(name)}.provenance.json")
+    written = draw_bench_figure(name, df, figures)
+    _metadata(figures, cfg, started, args, name=f"{stem(name)}.provenance.json", table=str(table))
+    return table, written
+
+
+def _bench_accuracy(args, cfg, started) -> None:
+    from .bench.accuracy import bench_accuracy
+
+    df = bench_accuracy(cfg, progress=lambda s: _progress(s, "accuracy"))
+    table, figures = _bench_with_figure("accuracy", df, args, cfg, started)
     if args.json:
         print(df.to_json(orient="records", indent=1))
     else:
         cols = ["tolerance", "image_order", "dtype", "softening_m", "us_per_agent_step", "max_abs_error",
                 "threshold_cross_fraction"]
         print(df[cols].to_string(index=False, float_format=lambda v: f"{v:.3g}"))
-        print(f"wrote {args.out}/bench_accuracy.parquet and bench_accuracy.png/.pdf")
+        print(f"wrote {table} and {', '.join(map(str, figures))}")
 
 
 def _bench_scaling(args, cfg, started) -> None:
-    from .bench.scaling import bench_scaling, format_scaling, plot_scaling
-    from .io import atomic_path
+    from .bench.scaling import bench_scaling, format_scaling
 
     df = bench_scaling(cfg, progress=lambda c: _progress(c, "scaling", unit="case"))
-    args.out.mkdir(parents=True, exist_ok=True)
-    with atomic_path(args.out / "bench_scaling.parquet") as tmp:
-        df.to_parquet(tmp, index=False)
-    for ext in ("png", "pdf"):
-        with atomic_path(args.out / f"bench_scaling.{ext}") as tmp:
-            plot_scaling(df, tmp)
-    _metadata(args.out, cfg, started, args, name="bench_scaling.provenance.json")
+    table, figures = _bench_with_figure("scaling", df, args, cfg, started)
     print(df.to_json(orient="records", indent=1) if args.json else format_scaling(df))
+    if not args.json:
+        print(f"wrote {table} and {', '.join(map(str, figures))}")
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``efish`` console script."""
+    """Entry point of the ``efish`` console script: parse, compose the overrides (commands that take them), call the
+    command's handler; an error is one line on stderr and exit code 2."""
     args = _parser().parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="efish: %(message)s", stream=sys.stderr)
     started = datetime.now(timezone.utc)
     try:
-        cfg = compose(args.overrides)
-        if args.command == "select":
-            _select(args, cfg, started)
-        elif args.command == "config":
-            print(to_yaml(cfg), end="")
-        elif args.command == "schema":
-            from .rollout.schema import describe
-
-            print(describe(args.table))
-        elif args.command == "train":
-            _train(args, cfg, started)
-        elif args.command == "assay":
-            _assay(args, cfg, started)
-        elif args.command == "analyze":
-            _analyze(args, cfg, started)
-        elif args.command == "stack-seeds":
-            _stack_seeds(args, cfg, started)
-        elif args.command == "figure":
-            _figure(args, cfg, started)
-        elif args.command == "render":
-            _render(args, cfg, started)
-        elif args.command == "contact-sheet":
-            _contact_sheet(args, cfg, started)
-        elif args.command == "claims":
-            _claims(args, cfg, started)
-        elif args.command == "compare-claims":
-            _compare_claims(args)
-        elif args.command == "scene":
-            _scene(args, cfg, started)
-        elif args.command == "plan-cluster":
-            _plan_cluster(args)
-        elif args.command == "plan":
-            from .env.vec_env import scene_of
-            from .physics.plan import build_plan
-
-            print(build_plan(cfg, scene_of(cfg)).explain())
-        elif args.bench == "physics":
-            _bench_physics(args, cfg, started)
-        elif args.bench == "train":
-            from .bench.train import bench_train, format_train
-
-            rows = bench_train(cfg, tuple(args.hidden))
-            print(json.dumps(rows, indent=2) if args.json else format_train(rows))
-        elif args.bench == "budget":
-            _bench_budget(args, cfg, started)
-        elif args.bench == "env":
-            from .bench.env import bench_env, format_env
-
-            rows = bench_env(cfg, num_envs=args.envs, steps=args.steps)
-            print(json.dumps(rows, indent=2) if args.json else format_env(rows))
-        elif args.bench == "scaling":
-            _bench_scaling(args, cfg, started)
-        elif args.bench == "multipole":
-            from .bench.multipole import bench_multipole, format_multipole
-
-            table = bench_multipole(cfg, tuple(args.orders), args.width)
-            print(table.to_json(orient="records", indent=1) if args.json else format_multipole(table))
-        elif args.bench == "pipeline":
-            from .bench.pipeline import format_timings, pipeline_timings
-
-            table = pipeline_timings(args.results or Path(f"results/{cfg.scale.name}"))
-            print(table.to_json(orient="records", indent=1) if args.json else format_timings(table))
-        else:
-            _bench_accuracy(args, cfg, started)
+        cfg = compose(args.overrides) if "overrides" in args else None
+        args.handler(args, cfg, started)
     except (ConfigError, ValueError, OSError) as exc:
         print(f"efish: error: {exc}", file=sys.stderr)
         return 2

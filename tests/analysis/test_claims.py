@@ -26,11 +26,12 @@ from efish.analysis.registry import run
 from efish.analysis.signalling import fit_power_law
 from efish.analysis.stats import spearman
 from efish.cli import main
+from efish.layout import analysis_table, assay_table
 
 from ..helpers import cfg_with, rollout_tables
 
 CFG = cfg_with("analysis.claims_resamples=40", "analysis.claims_fit_resamples=4")
-A, R = cl.analysis_table, cl.rollout_table
+A, R = analysis_table, assay_table
 
 
 def rng_for(name: str) -> np.random.Generator:

@@ -53,3 +53,25 @@ def test_bad_budgets_are_one_clear_error():
 
     with pytest.raises(ValueError, match="minutes > 0"):
         bench_budget(compose(["scale=smoke"]), (64,), seeds=2, minutes=0)
+
+
+def test_efish_bench_budget_flags_override_the_config_fields_and_are_recorded(tmp_path, monkeypatch, capsys):
+    from efish.bench import budget
+    from efish.cli import main
+
+    seen = {}
+
+    def fake(cfg, progress=None):
+        seen["sizes"] = budget.budget_sizes(cfg)
+        table = _table([(8, 1, 1.0, 30, 500, 1.0)])
+        table.attrs.update(minutes=0.5, seeds=1, jobs=1, cpu="test CPU")
+        return table
+
+    monkeypatch.setattr(budget, "bench_budget", fake)
+    assert main(["bench", "budget", "scale=smoke", "bench.budget_seeds=1", "--minutes", "0.5", "--hidden", "8",
+                 "--out", str(tmp_path)]) == 0
+    assert seen["sizes"] == ((8,), 1, 0.5, 2)  # jobs: the config's default
+    assert "budget_minutes: 0.5" in (tmp_path / "config.yaml").read_text()
+    assert "1 runs of 0.5 min" in capsys.readouterr().err
+    assert main(["bench", "budget", "scale=smoke", "--seeds", "0"]) == 2
+    assert capsys.readouterr().err.startswith("efish: error: bench budget needs minutes > 0, seeds >= 1")

@@ -118,3 +118,17 @@ def test_efish_bench_multipole_prints_its_table_and_rejects_a_bad_width(capsys):
     assert "ns/cell-point" in capsys.readouterr().out
     assert main(["bench", "multipole", "--width", "-5"]) == 2
     assert capsys.readouterr().err.strip() == "efish: error: width_cm must be positive, got -5.0"
+
+
+def test_the_orders_and_width_are_config_fields_the_flags_override(capsys):
+    import json
+
+    from efish.cli import main
+
+    sizes = ["bench.scaling_n_agents=1", "bench.multipole_orders=[2]", "bench.multipole_width_cm=50"]
+    assert main(["bench", "multipole", *sizes, "--json"]) == 0
+    assert {r["order"] for r in json.loads(capsys.readouterr().out)} == {2}
+    assert main(["bench", "multipole", *sizes, "--orders", "3", "--json"]) == 0
+    assert {r["order"] for r in json.loads(capsys.readouterr().out)} == {3}
+    assert main(["bench", "multipole", "bench.multipole_width_cm=-1"]) == 2  # the schema's range
+    assert "bench.multipole_width_cm=-1" in capsys.readouterr().err

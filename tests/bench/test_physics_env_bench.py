@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from efish.bench.env import bench_env
-from efish.bench.physics import bench_physics
+from efish.bench.env import bench_env, format_env
+from efish.bench.physics import bench_physics, format_physics
 
 from ..helpers import cfg_with
 
@@ -13,6 +13,8 @@ def test_physics_bench_reports_positive_rates_and_agrees_with_the_reference():
                                "bench.reference_rounds=1"))
     assert r["fast_agent_steps_per_s"] > 0 and r["reference_agent_steps_per_s"] > 0
     assert r["max_abs_diff_normalised"] <= 1e-6
+    assert r["cpu"] and r["cpu_capability"]
+    assert format_physics(r).splitlines()[0] == f"CPU: {r['cpu']} (torch CPU capability {r['cpu_capability']})"
 
 
 def test_env_bench_has_a_row_per_scene_with_positive_rates():
@@ -20,3 +22,10 @@ def test_env_bench_has_a_row_per_scene_with_positive_rates():
     assert len(rows) == 2
     for row in rows:
         assert all(v > 0 for k, v in row.items() if isinstance(v, float))
+    assert "torch CPU capability" in format_env(rows).splitlines()[0]
+
+
+def test_env_bench_sizes_are_config_fields():
+    rows = bench_env(cfg_with("bench.reference_rounds=1", "bench.env_envs=1", "bench.env_steps=2"),
+                     reference_steps=1)
+    assert [r["num_envs"] for r in rows] == [1, 1]

@@ -213,3 +213,18 @@ def test_the_compose_cache_serves_equal_configs_and_follows_every_edit_of_the_tr
     monkeypatch.delenv("EFISH_CACHE_DIR")
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))  # without it: beside numba's kernels
     assert composer.cache_folder() == tmp_path / "xdg" / "efish" / "compose"
+
+
+def test_the_compose_cache_is_keyed_by_the_schema_this_process_loaded(tmp_path, monkeypatch):
+    """A process started before schema.py was edited builds configs of the schema it loaded: its entries carry the
+    digest of the sources it imported, so a process of the edited schema never reads them (and the reverse)."""
+    import importlib
+
+    composer = importlib.import_module("efish.config.compose")
+    monkeypatch.setenv("EFISH_CACHE_DIR", str(tmp_path / "cache"))
+    composer.compose(["scale=smoke"])
+    entries = set((tmp_path / "cache" / "compose").glob("*.pkl"))
+    assert len(entries) == 1
+    monkeypatch.setattr(composer, "_SOURCES_DIGEST", "the digest of another schema")
+    composer.compose(["scale=smoke"])
+    assert len(set((tmp_path / "cache" / "compose").glob("*.pkl"))) == 2  # composed afresh under its own key

@@ -1,10 +1,11 @@
 """A results folder of synthetic tables shaped like a real run's: every assay of the laptop scale gets
-rollout tables from ``tests.helpers.rollout_tables`` with its own conditions and agent count, and every
-analysis of it runs for real on them (``efish.analysis.registry.run``), so panels are drawn from the same
-table shapes the pipeline writes."""
+rollout tables from ``tests.helpers.rollout_tables`` with its own conditions and agent count, and the
+``conditions.parquet`` efish assay records (:func:`conditions_of`), and every analysis of it runs for real on
+them (``efish.analysis.registry.run``), so panels are drawn from the same table shapes the pipeline writes."""
 
 from __future__ import annotations
 
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +16,10 @@ from tests.helpers import rollout_tables
 from efish.analysis.registry import analyses_for, run, tables_written
 from efish.analysis.selection import rank_seeds, seed_statistics, stack_top_seeds
 from efish.config import compose
+from efish.figures.panel import conditions_key
+from efish.rollout.assay import condition_configs
+from efish.rollout.conditions import conditions_table
+from efish.rollout.tables import write_tables
 
 SEEDS = 2
 
@@ -22,7 +27,17 @@ SEEDS = 2
 def _write(tables: dict[str, pd.DataFrame], folder: Path) -> None:
     folder.mkdir(parents=True, exist_ok=True)
     for name, table in tables.items():
-        table.to_parquet(folder / f"{name}.parquet", index=False)
+        if name == "conditions":  # as efish assay writes it, with its declared schema
+            write_tables({name: table}, folder)
+        else:
+            table.to_parquet(folder / f"{name}.parquet", index=False)
+
+
+@lru_cache(maxsize=None)
+def conditions_of(assay: str, *overrides: str) -> pd.DataFrame:
+    """``assays/<assay>/conditions.parquet`` as efish assay records it at the smoke scale under ``overrides``
+    (e.g. ``env.fps=25``): every condition's resolved config. Shared: copy before editing."""
+    return conditions_table(condition_configs(["scale=smoke", *overrides, f"assay={assay}"]))
 
 
 def _assay_tables(name: str, seed: int) -> tuple[dict, object]:
@@ -30,7 +45,19 @@ def _assay_tables(name: str, seed: int) -> tuple[dict, object]:
     conditions = tuple(cfg.assay.conditions) or ("control",)
     tables = rollout_tables(seed=seed, conditions=conditions, episodes=3, n_agents=max(cfg.env.n_agents, 2),
                             steps=120, error_angles=cfg.env.task == "homing", arena_cm=cfg.arena.width_cm)
+    tables["conditions"] = conditions_of(name)
     return {t: tables[t] for t in tables_written(cfg.assay)}, cfg
+
+
+@pytest.fixture(scope="session")
+def recorded():
+    """``recorded("onepatch", "bot")``: the conditions tables a panel's draw function reads beside its inputs,
+    keyed like :attr:`efish.figures.panel.Panel.conditions`; ``overrides=[...]`` records them under run
+    overrides."""
+    def tables(*assays: str, overrides=()) -> dict[str, pd.DataFrame]:
+        return {conditions_key(a): conditions_of(a, *overrides) for a in assays}
+
+    return tables
 
 
 @pytest.fixture(scope="session")

@@ -1,4 +1,5 @@
-"""Episode clips (``efish render``): frames drawn from synthetic rollout tables, checked artist by artist."""
+"""Episode clips (``efish render``): frames drawn from synthetic rollout tables and the conditions the run recorded,
+checked artist by artist."""
 
 from __future__ import annotations
 
@@ -15,6 +16,7 @@ from efish.config import compose
 from efish.figures import episode as episode_module
 from efish.figures.episode import FieldOverlay, clip_writer, draw_frame, frame_rows, load_episode, render_clip, spans
 from efish.figures.style import panel_style
+from efish.rollout.tables import write_tables
 
 OVERRIDES = ["scale=smoke", "assay=patchy4"]  # one condition, "control", in a 70 x 70 arena
 STEPS = 30
@@ -27,9 +29,10 @@ def cfg():
 
 
 @pytest.fixture(scope="module")
-def tables(tmp_path_factory):
-    """steps/food.parquet of two episodes of "control" (3 agents, 30 steps); in episode 0 pellet 0 is eaten
-    by agent 1 at step 10, pellet 1 spawns at step 5, and agent 0 bites agent 2 at step 12."""
+def tables(tmp_path_factory, recorded):
+    """steps/food.parquet of two episodes of "control" (3 agents, 30 steps) and patchy4's conditions.parquet; in
+    episode 0 pellet 0 is eaten by agent 1 at step 10, pellet 1 spawns at step 5, and agent 0 bites agent 2 at
+    step 12."""
     t = rollout_tables(seed=3, conditions=("control",), episodes=2, n_agents=3, steps=STEPS)
     steps, food = t["steps"], t["food"]
     first = (food["episode"] == 0)
@@ -42,6 +45,13 @@ def tables(tmp_path_factory):
     folder = tmp_path_factory.mktemp("assay")
     steps.to_parquet(folder / "steps.parquet", index=False)
     food.to_parquet(folder / "food.parquet", index=False)
+    write_tables({"conditions": recorded("patchy4")["conditions/patchy4"]}, folder)
+    return folder
+
+
+def copy_tables(tables, folder, names=("steps", "food", "conditions")):
+    for name in names:
+        (folder / f"{name}.parquet").write_bytes((tables / f"{name}.parquet").read_bytes())
     return folder
 
 
@@ -147,9 +157,28 @@ def test_unknown_condition_episode_and_missing_tables_are_one_clear_error(tables
     with pytest.raises(ValueError, match="missing rollout table"):
         load_episode(tmp_path, OVERRIDES, cfg, "control", 0)
     (tmp_path / "config.yaml").write_text("assay:\n  name: wide2\n")
-    for name in ("steps", "food"):
-        (tmp_path / f"{name}.parquet").write_bytes((tables / f"{name}.parquet").read_bytes())
+    copy_tables(tables, tmp_path)
     with pytest.raises(ValueError, match="are assay wide2's.*pass assay=wide2"):
+        load_episode(tmp_path, OVERRIDES, cfg, "control", 0)
+
+
+def test_the_clip_draws_the_condition_as_the_run_recorded_it(tables, cfg, recorded, tmp_path):
+    """fps, arena and physics are the recorded condition's (the run's overrides), whatever ``overrides`` says."""
+    copy_tables(tables, tmp_path, ("steps", "food"))
+    conditions = recorded("patchy4", overrides=("env.fps=25", "arena.width_cm=90"))["conditions/patchy4"]
+    write_tables({"conditions": conditions}, tmp_path)
+    ep = load_episode(tmp_path, OVERRIDES, cfg, "control", 0)
+    assert (ep.fps, ep.cfg.arena.width_cm) == (25.0, 90.0)
+    assert list(frame_rows(ep, None, ".mp4")) == list(range(STEPS))  # 25 fps plays every step in real time
+    assert list(frame_rows(ep, None, ".gif")) == list(range(STEPS))
+
+
+def test_tables_without_recorded_conditions_or_of_another_assay_are_one_clear_error(tables, cfg, recorded, tmp_path):
+    copy_tables(tables, tmp_path, ("steps", "food"))
+    with pytest.raises(ValueError, match=r"missing .*conditions\.parquet.*rerun the assay"):
+        load_episode(tmp_path, OVERRIDES, cfg, "control", 0)
+    write_tables({"conditions": recorded("wide2")["conditions/wide2"]}, tmp_path)  # no config.yaml to check
+    with pytest.raises(ValueError, match=r"are assay wide2's \(its conditions\.parquet\).*pass assay=wide2"):
         load_episode(tmp_path, OVERRIDES, cfg, "control", 0)
 
 

@@ -152,6 +152,19 @@ def test_eod_rate_is_probability_times_frame_rate(tables):
     np.testing.assert_allclose(y, probability * compose(["assay=patchy4"]).env.fps, rtol=1e-6)
 
 
+def test_rates_and_arena_follow_the_frame_rate_and_arena_the_run_recorded(tables, recorded):
+    """A run at 25 fps in a 90 x 80 cm arena: panel O's Hz are probability x 25, panel B's limits that arena."""
+    overridden = recorded("patchy4", overrides=("env.fps=25", "arena.width_cm=90", "arena.height_cm=80"))
+    probability = tables["fig3/O"]["eod_probability"]["eod_probability"].to_numpy()
+    with drawn("fig3/O", {**tables["fig3/O"], **overridden}) as ax:
+        y = ax.collections[0].get_offsets()[:, 1]
+        top = ax.dataLim.ymax
+    np.testing.assert_allclose(y, probability * 25.0, rtol=1e-6)
+    assert top == pytest.approx(25.0 * probability.max(), rel=1e-6)
+    with drawn("fig3/B", {**tables["fig3/B"], **overridden}) as ax:
+        assert (ax.get_xlim(), ax.get_ylim()) == ((0, 90), (0, 80))
+
+
 def test_theil_panel_reads_its_test_when_the_table_holds_one(tables):
     full = tables["fig3/N"]
     base = {**full, "size_tests": full["size_tests"][full["size_tests"]["measure"] != "theil_t"]}

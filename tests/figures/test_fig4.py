@@ -9,7 +9,7 @@ import pytest
 from efish.figures import fig4
 from efish.figures.registry import PANELS
 from efish.figures.render import load_tables, render_panel
-from efish.figures.style import box_strip, panel_style
+from efish.figures.style import assay_conditions, box_strip, panel_style
 
 from ..helpers import draw_panel_axes as draw
 from ..helpers import panel_texts as texts
@@ -47,35 +47,42 @@ def test_every_panel_renders_with_labelled_axes(key, synthetic_results, tmp_path
     assert said_missing or (ax.get_xlabel() and ax.get_ylabel()), key
 
 
-def test_conditions_follow_the_assay_config_with_the_control_first():
+def test_conditions_follow_the_recorded_order_with_the_control_first(recorded):
     present = ["A_K", "K", "M_A", "M_A_K", "M_K", "none"]  # alphabetical, as the tables are sorted
-    assert fig4.condition_order("ablation4", present, "M_A_K") == ["M_A_K", "M_A", "M_K", "A_K", "K", "none"]
-    assert fig4.condition_order("mute", ["muted", "intact", "extra"], "intact") == ["intact", "muted", "extra"]
-    with pytest.raises(ValueError, match="no assay config"):
-        fig4.condition_order("not_an_assay", ["a"])
+    tables = recorded("ablation4", "mute")
+    assert fig4.condition_order(tables, "ablation4", present, "M_A_K") == ["M_A_K", "M_A", "M_K", "A_K", "K", "none"]
+    assert fig4.condition_order(tables, "mute", ["muted", "intact", "extra"], "intact") == ["intact", "muted",
+                                                                                            "extra"]
+    with pytest.raises(ValueError, match=r"no conditions/npatch \(assays/npatch/conditions.parquet\)"):
+        fig4.condition_order(tables, "npatch", ["a"])
+    # the order is the run's record, whatever the config files say now
+    reordered = tables["conditions/ablation4"].assign(position=lambda t: t["position"].max() - t["position"])
+    assert fig4.condition_order({"conditions/ablation4": reordered}, "ablation4", present) == [
+        "none", "K", "A_K", "M_K", "M_A", "M_A_K"]
 
 
-def test_ablation_panel_draws_the_episodes_and_the_dunnett_stars_of_the_table():
+def test_ablation_panel_draws_the_episodes_and_the_dunnett_stars_of_the_table(recorded):
     values = {"M_A_K": [4.0, 6.0, 5.0], "M_A": [1.0, 2.0, 3.0], "none": [0.0, 1.0, 0.0]}
     tests = pd.concat([dunnett({"M_A": "**", "none": "ns"}, "M_A_K"),
                        dunnett({"M_A": "****", "none": "****"}, "M_A_K", measure="theil_t")])  # other measure
-    ax = draw("fig4/B", {"summary": summary(values), "tests": tests})
+    ax = draw("fig4/B", {"summary": summary(values), "tests": tests, **recorded("ablation4")})
     assert [t.get_text() for t in ax.get_xticklabels()] == ["M+A+K", "M+A", "none"]
     for i, cond in enumerate(["M_A_K", "M_A", "none"]):
         np.testing.assert_allclose(points_at(ax, i), sorted(values[cond]))
     assert sorted(texts(ax)) == ["**", "ns"]
 
 
-def test_a_condition_without_a_test_row_is_marked_n_a():
+def test_a_condition_without_a_test_row_is_marked_n_a(recorded):
     ax = draw("fig4/G", {"summary": summary({"control": [1.0, 2.0], "self_only": [0.0, 1.0]}),
-                         "tests": dunnett({}, "control").reindex(columns=["group", "control", "stars", "measure"])})
+                         "tests": dunnett({}, "control").reindex(columns=["group", "control", "stars", "measure"]),
+                         **recorded("collective")})
     assert texts(ax) == ["n/a"]
 
 
-def test_collective_shows_the_authors_self_only_mode_beside_the_clean_gate():
+def test_collective_shows_the_authors_self_only_mode_beside_the_clean_gate(recorded):
     values = {"control": [6.0, 6.0], "self_only": [5.0, 4.0], "self_only_authors": [5.5, 5.0], "cons_only": [6.0]}
     tests = dunnett({"self_only": "*", "self_only_authors": "**", "cons_only": "ns"}, "control")
-    ax = draw("fig4/G", {"summary": summary(values), "tests": tests})
+    ax = draw("fig4/G", {"summary": summary(values), "tests": tests, **recorded("collective")})
     labels = [t.get_text() for t in ax.get_xticklabels()]
     assert labels == ["control", "self only\n(clean gate)", "self only\n(authors' mode)", "cons only"]
     np.testing.assert_allclose(points_at(ax, 2), [5.0, 5.5])
@@ -83,11 +90,11 @@ def test_collective_shows_the_authors_self_only_mode_beside_the_clean_gate():
     assert "authors' mode" in PANELS["fig4/G"].caption and "wall_distortion" in PANELS["fig4/G"].caption
 
 
-def test_mute_draws_the_results_design_first_and_the_methods_design_beside_it():
+def test_mute_draws_the_results_design_first_and_the_methods_design_beside_it(recorded):
     values = {"intact": [6.0, 7.0], "muted": [3.0, 4.0], "intact4": [20.0, 22.0], "muted4": [18.0]}
     tests = pd.concat([dunnett({"muted": "***", "intact4": "****", "muted4": "****"}, "intact"),
                        dunnett({"muted4": "*"}, "intact4", measure="theil_t")])  # another measure: not drawn
-    ax = draw("fig4/I", {"summary": summary(values), "tests": tests})
+    ax = draw("fig4/I", {"summary": summary(values), "tests": tests, **recorded("mute")})
     for x, cond in [(0, "intact"), (1, "muted"), (3, "intact4"), (4, "muted4")]:  # an empty slot between designs
         np.testing.assert_allclose(points_at(ax, x), sorted(values[cond]))
     assert [t.get_text() for t in ax.get_xticklabels()] == ["none\nmuted", "agent 1\nmuted", "",
@@ -98,10 +105,8 @@ def test_mute_draws_the_results_design_first_and_the_methods_design_beside_it():
     assert sorted(texts(ax)) == ["***", "n/a"]
 
 
-def test_mute_designs_follow_the_assay_config():
-    from efish.figures.style import assay_conditions
-
-    configs = assay_conditions("mute")
+def test_mute_designs_follow_the_assay_config(recorded):
+    configs = assay_conditions(recorded("mute"), "mute")
     assert list(configs) == [c for intact, muted, _ in fig4.MUTE_DESIGNS for c in (intact, muted)]
     (intact, muted, _), (intact4, muted4, _) = fig4.MUTE_DESIGNS
     assert (configs[intact].env.n_agents, configs[intact].arena.layout, configs[muted].env.muted) == (2, "uniform", [1])
@@ -110,9 +115,18 @@ def test_mute_designs_follow_the_assay_config():
     assert configs[intact].assay.seed == configs[intact4].assay.seed  # paired episodes within each design
 
 
-def test_a_measure_without_finite_values_says_why():
+def test_mute_design_labels_follow_the_recorded_arena_and_agents(recorded):
+    """A run in a 100 x 90 cm arena labels its designs with that arena (the mute conditions set agents, not size)."""
+    overridden = recorded("mute", overrides=("arena.width_cm=100", "arena.height_cm=90"))
+    groups, labels = fig4.mute_design_labels(assay_conditions(overridden, "mute"))
+    assert groups == ["2 agents, uniform 100x90\n(Results, decides C12)", "4 agents, patchy 100x90\n(Methods)"]
+    assert labels["muted"] == "agent 1\nmuted"
+
+
+def test_a_measure_without_finite_values_says_why(recorded):
     frame = summary({"intact": [np.nan], "muted": [np.nan]}, "mean_nn_dist_cm").assign(reason="no other agent")
-    ax = draw("fig4/J", {"summary": frame, "tests": dunnett({"muted": "n/a"}, "intact", "mean_nn_dist_cm")})
+    ax = draw("fig4/J", {"summary": frame, "tests": dunnett({"muted": "n/a"}, "intact", "mean_nn_dist_cm"),
+                         **recorded("mute")})
     assert any("no other agent" in t for t in texts(ax))
 
 

@@ -32,10 +32,10 @@ def test_every_panel_renders_with_labelled_axes(key, synthetic_results, tmp_path
     assert said_missing or (ax.get_xlabel() and ax.get_ylabel()), key
 
 
-def test_decoding_bars_are_the_scores_best_first_without_unscored_targets():
+def test_decoding_bars_are_the_scores_best_first_without_unscored_targets(recorded):
     table = pd.DataFrame({"condition": "control", "target": ["log_morm_sensed", "dist_agent_cm", "size", "dist_food_cm"],
                           "score": [0.2, 0.6, np.nan, -0.1], "reason": ["", "", "constant target", ""]})
-    ax = draw("fig6/E", {"decoding": table})
+    ax = draw("fig6/E", {"decoding": table, **recorded("wide2")})
     widths = [p.get_width() for p in ax.patches if p.get_height() > 0]
     np.testing.assert_allclose(widths, [0.6, 0.2, -0.1])
     assert [t.get_text() for t in ax.get_yticklabels()] == ["nearest agent: distance", "log reading (M, sensed)",
@@ -43,12 +43,12 @@ def test_decoding_bars_are_the_scores_best_first_without_unscored_targets():
 
 
 @pytest.mark.parametrize("with_column", [True, False])
-def test_readouts_are_drawn_hatched_below_the_sensed_targets_and_not_ranked_among_them(with_column):
+def test_readouts_are_drawn_hatched_below_the_sensed_targets_and_not_ranked_among_them(with_column, recorded):
     """Decoding rule: the own turn, EOD and size are drawn as readouts, after every sensed target, even when
     they score best; a table without the readout column (an earlier run) is marked by target."""
     table = pd.DataFrame({"condition": "control", "target": ["turn_rad", "dist_agent_cm", "eod", "dist_wall_cm"],
                           "readout": [True, False, True, False], "score": [0.8, 0.3, 0.6, 0.1], "reason": ""})
-    ax = draw("fig6/E", {"decoding": table if with_column else table.drop(columns="readout")})
+    ax = draw("fig6/E", {"decoding": table if with_column else table.drop(columns="readout"), **recorded("wide2")})
     bars = [p for p in ax.patches if p.get_height() > 0]
     np.testing.assert_allclose([p.get_width() for p in bars], [0.3, 0.1, 0.8, 0.6])
     assert [t.get_text() for t in ax.get_yticklabels()] == ["nearest agent: distance", "wall: distance",
@@ -57,31 +57,31 @@ def test_readouts_are_drawn_hatched_below_the_sensed_targets_and_not_ranked_amon
     assert any(line.get_linestyle() == "--" for line in ax.get_lines())  # the line between the two groups
 
 
-def test_decoding_without_any_score_says_why():
+def test_decoding_without_any_score_says_why(recorded):
     table = pd.DataFrame({"condition": ["electric"], "target": ["size"], "score": [np.nan],
                           "reason": ["constant target"]})
-    ax = draw("fig6/D", {"decoding": table})
+    ax = draw("fig6/D", {"decoding": table, **recorded("homing")})
     assert any("constant target" in t for t in texts(ax))
 
 
-def test_food_decoding_bars_pair_near_and_far_scores_per_variable():
+def test_food_decoding_bars_pair_near_and_far_scores_per_variable(recorded):
     table = pd.DataFrame({"condition": "control", "food": ["near", "near", "far", "far"],
                           "target": ["dist_food_cm", "bearing_food_rad"] * 2, "score": [0.5, 0.3, -0.05, np.nan],
                           "reason": ["", "", "", "fewer than 2 groups (episodes) with finite rows (1)"]})
-    ax = draw("fig6/F", {"food_decoding": table})
+    ax = draw("fig6/F", {"food_decoding": table, **recorded("wide2")})
     widths = sorted(p.get_width() for p in ax.patches if p.get_height() > 0 and np.isfinite(p.get_width()))
     np.testing.assert_allclose(widths, [-0.05, 0.3, 0.5])
     assert {t.get_text() for t in ax.get_yticklabels()} == {"food: distance", "food: bearing"}
     assert [t.get_text() for t in ax.get_legend().get_texts()] == ["near", "far"]
-    empty = draw("fig6/F", {"food_decoding": table.assign(score=np.nan)})
+    empty = draw("fig6/F", {"food_decoding": table.assign(score=np.nan), **recorded("wide2")})
     assert any("fewer than 2 groups" in t for t in texts(empty))
 
 
-def test_plsc_bars_are_the_table_values_and_an_empty_bin_says_n_a():
+def test_plsc_bars_are_the_table_values_and_an_empty_bin_says_n_a(recorded):
     table = pd.DataFrame({"lo_cm": [0.0, 10.0, 100.0], "hi_cm": [10.0, 100.0, np.inf], "n_steps": [3, 50, 40],
                           "n_significant": [np.nan, 3.0, 0.0], "s_1": [np.nan, 2.5, 1.0],
                           "reason": ["need T >= 10", "", ""], "condition": "control"})
-    ax = draw("fig6/H", {"plsc": table})
+    ax = draw("fig6/H", {"plsc": table, **recorded("wide2")})
     np.testing.assert_allclose([p.get_height() for p in ax.patches], [3.0, 0.0])
     assert sorted(texts(ax)) == ["0", "3", "n/a"]
     assert [t.get_text() for t in ax.get_xticklabels()] == ["<= 10", "10-100", "> 100"]
@@ -121,21 +121,38 @@ def test_deff_vs_group_size_means_per_knollenorgan_state():
     np.testing.assert_allclose(means["K off"], [1.0, 1.5])
 
 
-def test_power_near_far_draws_each_agent_episode_and_the_wilcoxon_stars():
+def test_power_near_far_draws_each_agent_episode_and_the_wilcoxon_stars(recorded):
     power = pd.DataFrame({"condition": "control", "episode": [0, 0, 1, 1], "agent": 0,
                           "where": ["near", "far"] * 2, "wideband_power": [1.0, 3.0, 2.0, 5.0], "reason": ""})
     tests = pd.DataFrame({"measure": ["near_far", "size"], "stars": ["XNEAR", "XSIZE"]})
-    ax = draw("fig6/I", {"power": power, "tests": tests})
+    wide2 = recorded("wide2")
+    ax = draw("fig6/I", {"power": power, "tests": tests, **wide2})
     by_x = {}
     for c in ax.collections:
         for x, y in c.get_offsets():
             by_x.setdefault(round(x), []).append(y)
     assert sorted(by_x[0]) == [1.0, 2.0] and sorted(by_x[1]) == [3.0, 5.0]
     assert [t for t in texts(ax) if t.startswith("X")] == ["XNEAR"]
-    small = draw("fig6/I", {"power": power.assign(wideband_power=power["wideband_power"] * 1e-3), "tests": tests})
+    small = draw("fig6/I", {"power": power.assign(wideband_power=power["wideband_power"] * 1e-3), "tests": tests,
+                            **wide2})
     drawn = sorted(y for c in small.collections for _, y in c.get_offsets())
     np.testing.assert_allclose(drawn, [1.0, 2.0, 3.0, 5.0])  # in units of 10^-3, which the label names
     assert "10$^{-3}$" in small.get_ylabel()
     nan_row = pd.DataFrame([{"where": np.nan, "wideband_power": np.nan, "reason": "the rollout table lacks x"}])
-    ax = draw("fig6/I", {"power": nan_row, "tests": tests})
+    ax = draw("fig6/I", {"power": nan_row, "tests": tests, **wide2})
     assert any("lacks x" in t for t in texts(ax))
+
+
+def test_thresholds_named_on_the_panels_are_the_runs(recorded):
+    """The near / far distances on panel I's ticks and panel F's legend are the analysis settings the run
+    recorded, not the schema's defaults."""
+    wide2 = recorded("wide2", overrides=("analysis.claims_near_cm=7", "analysis.claims_far_cm=45",
+                                         "analysis.claims_food_near_cm=3"))
+    power = pd.DataFrame({"condition": "control", "episode": [0, 0], "agent": 0, "where": ["near", "far"],
+                          "wideband_power": [1.0, 3.0], "reason": ""})
+    ax = draw("fig6/I", {"power": power, "tests": pd.DataFrame({"measure": ["near_far"], "stars": ["*"]}), **wide2})
+    assert [t.get_text() for t in ax.get_xticklabels()] == ["near (<= 7 cm)", "far (> 45 cm)"]
+    table = pd.DataFrame({"condition": "control", "food": ["near", "far"], "target": "dist_food_cm",
+                          "score": [0.5, 0.1], "reason": ""})
+    ax = draw("fig6/F", {"food_decoding": table, **wide2})
+    assert ax.get_legend().get_title().get_text() == "food (near: <= 3 cm)"

@@ -6,11 +6,12 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from efish import layout
 from efish.analysis.behaviour import food_per_agent_episode
 from efish.analysis.behaviour import food_vs_size as fit_food_vs_size
 from efish.figures import fig3
 from efish.figures.registry import PANELS, figures, panels_for
-from efish.figures.render import input_paths, load_tables, render_page, render_panel
+from efish.figures.render import input_paths, load_tables, render_figure, render_panel
 from efish.figures.style import panel_style
 from efish.rollout.schema import EPISODES
 
@@ -46,14 +47,68 @@ def test_panels_need_the_assays_they_read():
     assert "fig2/B" not in {p.key for p in panels_for(["patchy4"])}
 
 
+def test_every_input_is_a_table_of_the_layout():
+    """Each path a panel reads is an assay, analysis or stacked top-seed table (layout.parse_table reads it), or a
+    training, ranking or scene file of the layout."""
+    others = {layout.training_file(layout.seed_name("{seed}"), "metrics.parquet"), layout.RANKING}
+    for panel in PANELS.values():
+        for path in panel.tables.values():
+            parsed = layout.parse_table(path)
+            if parsed is None:
+                scene = layout.scene_table(path.removeprefix("scenes/").removesuffix(".parquet"))
+                assert path in {*others, scene}, (panel.key, path)
+            else:
+                rebuilt = {"assays": lambda t: layout.assay_table(t.assay, t.table),
+                           "analysis": lambda t: layout.analysis_table(t.analysis, t.assay, t.table),
+                           "seeds": lambda t: layout.stacked_seeds_table(t.assay)}[parsed.kind](parsed)
+                assert rebuilt == path, (panel.key, path)
+
+
+def test_panels_read_the_conditions_of_every_assay_they_read(tmp_path):
+    panel = PANELS["fig5/I"]  # the bot assay's reach rates
+    assert panel.assays() == {"bot"}
+    assert panel.conditions == {"conditions/bot": "assays/bot/conditions.parquet"}
+    assert input_paths(panel, tmp_path, seeds=2)["conditions/bot"] == [tmp_path / "assays/bot/conditions.parquet"]
+    assert set(PANELS["fig3/P"].conditions) == {"conditions/patchy4"}
+    assert set(PANELS["supp/idi_histogram"].conditions) == {"conditions/patchy4", "conditions/wide2"}
+    for key in ("fig1/A", "supp/training_curves", "supp/top_seeds_food"):  # schematic, training, top seeds: none
+        assert not PANELS[key].conditions and PANELS[key].tables == PANELS[key].inputs
+    for panel in PANELS.values():
+        assert set(panel.tables) == set(panel.inputs) | {f"conditions/{a}" for a in panel.assays()}
+
+
+def test_a_missing_conditions_table_says_to_rerun_the_assay(synthetic_results, tmp_path):
+    results = tmp_path / "results"
+    for name in PANELS["fig3/O"].inputs.values():
+        (results / name).parent.mkdir(parents=True, exist_ok=True)
+        (results / name).write_bytes((synthetic_results / name).read_bytes())
+    with pytest.raises(ValueError, match=r"needs .*assays/patchy4/conditions\.parquet.*rerun the assay"):
+        load_tables(PANELS["fig3/O"], results, seeds=2)
+
+
 def test_seed_paths_expand_over_every_seed(tmp_path):
     paths = input_paths(PANELS["supp/training_curves"], tmp_path, seeds=3)
     assert [p.parent.name for p in paths["metrics"]] == ["seed_1", "seed_2", "seed_3"]
 
 
-def test_a_page_holds_every_panel_of_its_figure(synthetic_results, tmp_path):
-    written = render_page("fig2", figures()["fig2"], synthetic_results, tmp_path, seeds=2)
-    assert {p.name for p in written} == {"fig2.png", "fig2.pdf"}
+def test_a_figure_draws_each_panel_and_its_page(synthetic_results, tmp_path):
+    panels = figures()["fig2"]
+    written = render_figure("fig2", panels, synthetic_results, tmp_path, seeds=2)
+    assert {p.name for p in written["fig2"]} == {"fig2.png", "fig2.pdf"}
+    for panel in panels:
+        assert written[panel.key] == [tmp_path / "fig2" / f"{panel.name}.{ext}" for ext in ("png", "pdf")]
+        assert all(path.is_file() for path in written[panel.key])
+
+
+def test_a_figure_with_a_missing_table_writes_nothing(synthetic_results, tmp_path):
+    """Every table is read before the first drawing: no partial outputs."""
+    import shutil
+
+    results = shutil.copytree(synthetic_results, tmp_path / "results")  # the fixture is shared: a copy to break
+    (results / "assays/homing/steps.parquet").unlink()
+    with pytest.raises(ValueError, match="which does not exist"):
+        render_figure("fig2", figures()["fig2"], results, tmp_path / "out", seeds=2)
+    assert not (tmp_path / "out").exists()
 
 
 def test_per_seed_tables_carry_their_seed(synthetic_results):

@@ -123,6 +123,18 @@ def test_tolerance_zero_agrees_to_round_off(overrides, seed):
                                    atol=1e-6 * e_min(overrides, name), err_msg=name)
 
 
+def test_the_reference_follows_a_configured_eps0():
+    """The reference's closed-form fields take physics.eps0 from the plan, as the kernels take k."""
+    overrides = ("physics.eps0=1.2e-11",)
+    _, ref_raw, _ = reference(overrides, 10)
+    raw, _ = fast(overrides, 10, tolerance=0.0)
+    _, default_raw, _ = reference((), 10)
+    assert not np.allclose(ref_raw.ampullary, default_raw.ampullary)
+    for name in RAW:
+        np.testing.assert_allclose(getattr(raw, name), getattr(ref_raw, name), rtol=1e-9,
+                                   atol=1e-6 * e_min(overrides, name), err_msg=name)
+
+
 # float32. Positions are metres in float32, so a body 1 mm from a sensor is placed to ~3e-8 m,
 # i.e. ~3e-5 of the distance, ~1e-4 after the d^-3; readings are sums of many such terms whose
 # near and far parts (and the two terms of E.n of one dipole) cancel, which multiplies that

@@ -5,8 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from efish.config.schema import PhysicsConfig
 from efish.physics import coulomb_constant, dipole_field, monopole_field
-from efish.physics.fields import EPS0, SOFTENING_M
+
+EPS0, SOFTENING_M = PhysicsConfig().eps0, PhysicsConfig().softening_m  # the fields' keyword defaults
 
 K = 1.0 / (4.0 * np.pi * EPS0)
 CM = 0.01

@@ -75,7 +75,7 @@ def test_a_damaged_table_stops_a_panel_in_one_line(tmp_path):
     from efish.figures.registry import PANELS
 
     results, out = tmp_path / "results", tmp_path / "figures"
-    for path in PANELS["fig3/M"].inputs.values():  # every input present, all damaged
+    for path in PANELS["fig3/M"].tables.values():  # every input (its assays' conditions too) present, all damaged
         table = results / path
         table.parent.mkdir(parents=True, exist_ok=True)
         table.write_bytes(b"PAR1 truncated")

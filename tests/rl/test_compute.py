@@ -52,10 +52,10 @@ def test_cuda_without_a_cuda_device_is_one_clear_error():
         train(tiny(1, "train.device=cuda"), "unused")
 
 
-def test_the_retired_bf16_flag_names_its_replacement():
-    assert compose(["train.bf16=false"]).train.precision == "auto"  # old configs that leave it off still compose
-    with pytest.raises(ConfigError, match=r"train.bf16 is retired: set train.precision=bf16"):
-        compose(["train.bf16=true"])
+@pytest.mark.parametrize("value", ["true", "false"])
+def test_the_retired_bf16_flag_is_an_unknown_key(value):
+    with pytest.raises(ConfigError, match=r"^unknown config key 'train.bf16'$"):
+        compose([f"train.bf16={value}"])
 
 
 def test_explicit_cpu_device_runs_the_same_code_to_the_same_weights(tmp_path):
@@ -92,6 +92,7 @@ def test_a_checkpoint_from_before_precision_existed_still_resumes(tmp_path):
     del state["precision"]
     for key in ("precision", "bf16_speedup", "device"):
         del state["config"]["train"][key]
+    state["config"]["train"]["bf16"] = False  # the retired flag such checkpoints recorded
     torch.save(state, tmp_path / CHECKPOINT)
     df = train(tiny(2), tmp_path)
     assert list(df["update"]) == [1, 2] and df.attrs["compute"]["precision"] == "fp32"

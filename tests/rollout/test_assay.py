@@ -123,7 +123,26 @@ def test_an_assay_run_twice_gives_identical_tables():
                 for k, v in tables.items()}
     first, _ = run_assay(["assay=onepatch", *SHORT], SCRIPTED)
     second, _ = run_assay(["assay=onepatch", *SHORT], SCRIPTED)
+    conditions = first.pop("conditions"), second.pop("conditions")  # list cells: compared as frames
     assert digest(first) == digest(second)
+    pd.testing.assert_frame_equal(*conditions)
+
+
+def test_an_assay_records_what_its_conditions_resolved_to():
+    """conditions.parquet holds each condition as composed with the run's overrides, in the assay's order, and
+    reads back to the very configs that ran (the record panels and clips draw from)."""
+    from efish.config.recorded import recorded_conditions
+    from efish.rollout.schema import to_table
+
+    overrides = ["assay=onepatch", *SHORT, "env.fps=25"]
+    tables, _ = run_assay(overrides, SCRIPTED)
+    recorded = to_table(tables["conditions"], "conditions").to_pandas()
+    configs = condition_configs(overrides)
+    assert list(recorded["condition"]) == list(configs) and list(recorded["position"]) == list(range(len(configs)))
+    assert (recorded["fps"] == 25).all()
+    assert [list(s) for s in recorded["sizes"]] == [cfg.env.sizes for cfg in configs.values()]
+    assert list(recorded.loc[recorded["condition"] == "A_lt_B", "overrides"].iloc[0]) == ["env.sizes=[0.25,0.75]"]
+    assert dict(recorded_conditions(recorded)) == configs
 
 
 def test_bad_conditions_and_policies_fail_before_any_step():

@@ -133,6 +133,27 @@ def dry_run(work: Path, *args: str) -> subprocess.CompletedProcess:
                            "--directory", str(work), *args], capture_output=True, text=True, timeout=300)
 
 
+def job_counts(dry_run_output: str) -> dict[str, int]:
+    """Rule -> jobs, from the "Job stats" table Snakemake prints before a (dry) run."""
+    table = dry_run_output.split("Job stats:", 1)[1].split("\n\n", 1)[0]
+    rows = (line.split() for line in table.splitlines()[3:])
+    return {row[0]: int(row[1]) for row in rows if len(row) == 2 and row[0] != "total"}
+
+
+def test_one_job_draws_each_figure(tmp_path):
+    """Every panel of a figure and its page come from one job; the drawing jobs are one per figure page plus the
+    contact sheet (the benchmark figures are drawn by the jobs that measure them)."""
+    from efish.config import compose
+    from efish.figures.registry import drawable
+
+    result = dry_run(tmp_path, "--config", "scale=smoke")
+    assert result.returncode == 0, result.stderr[-2000:]
+    jobs = job_counts(result.stdout)
+    pages = {p.figure for p in drawable(compose(["scale=smoke"]).scale)}
+    drawing = {rule: n for rule, n in jobs.items() if rule.startswith(("figure", "panel", "contact_sheet"))}
+    assert drawing == {**{f"figure_{page}": 1 for page in pages}, "contact_sheet": 1}
+
+
 #: The claims' verdicts, and how seeds_agree counts them ("2/2 hold", "1/2 hold, 1/2 weaker (seed 1: ...)").
 VERDICTS = {"holds", "weaker", "fails", "not decidable", "not run"}
 COUNT = r"\d+/\d+ (hold|weaker|fail|not decidable)"
@@ -149,7 +170,7 @@ def test_the_other_top_seeds_rerun_the_claims_assays_for_their_own_claims(tmp_pa
     old, older = time.time() - 3600, time.time() - 7200
     for seed in (1, 2):
         for path, when in ((f"train/seed_{seed}/final.pt", older), (f"train/seed_{seed}/metrics.parquet", older),
-                           *((f"selection/seed_{seed}/{t}.parquet", old) for t in ("episodes", "steps", "food"))):
+                           *((f"selection/seed_{seed}/{t}.parquet", old) for t in ("episodes", "steps", "food", "conditions"))):
             (run / path).parent.mkdir(parents=True, exist_ok=True)
             (run / path).touch()
             os.utime(run / path, (when, when))
@@ -160,7 +181,7 @@ def test_the_other_top_seeds_rerun_the_claims_assays_for_their_own_claims(tmp_pa
                      "--rerun-triggers", "mtime", "--printshellcmds")
     assert result.returncode == 0, result.stderr[-2000:]
     out = result.stdout
-    assert ("efish assay assay=uniform4 scale=smoke scale.top_seeds=2 --policy selected=results/smoke/train/seed_1/final.pt "
+    assert ("efish assay scale=smoke scale.top_seeds=2 assay=uniform4 --policy selected=results/smoke/train/seed_1/final.pt "
             "--out results/smoke/seeds/seed_1/assays/uniform4") in out
     assert "results/smoke/seeds/seed_1/assays/wide2/hidden.parquet" in out  # record_hidden: dynamics reads it
     assert ("--tables results/smoke/seeds/seed_1/assays/wide2 --out results/smoke/seeds/seed_1/analysis/dynamics/wide2"
@@ -313,3 +334,44 @@ def test_a_bad_assay_condition_stops_before_any_job_in_one_line(tmp_path, condit
     last = result.stderr.strip().splitlines()[-1]
     assert last.startswith("efish workflow: assay bad") and message in last, result.stderr[-2000:]
     assert not (tmp_path / "results").exists()
+
+
+@pytest.mark.slow
+def test_a_run_override_reaches_every_drawing(smoke_run, tmp_path):
+    """env.fps on the command line and other one-patch sizes in the assay file: Fig 3's EOD-rate axis (Hz) and
+    Fig 5's size classes follow what the run recorded (conditions.parquet), not the config files, which the
+    drawings here read with the repository's own (default fps, default sizes). The smoke run's trained seeds are
+    reused (copied with their times, --rerun-triggers mtime) so that only the assays and what follows run."""
+    from efish.figures.fig5 import matched_alone
+    from efish.figures.registry import PANELS
+    from efish.figures.render import load_tables
+    from efish.figures.style import assay_conditions
+
+    from ..helpers import draw_panel_axes, scratch_workflow
+
+    work = scratch_workflow(tmp_path / "work")
+    onepatch = work / "config/assay/onepatch.yaml"
+    text = onepatch.read_text()
+    assert 'A_lt_B: ["env.sizes=[0.25,0.75]"]' in text
+    onepatch.write_text(text.replace('A_lt_B: ["env.sizes=[0.25,0.75]"]', 'A_lt_B: ["env.sizes=[0.5,0.75]"]'))
+    run = work / "results/fps"
+    for part in ("train", "selection", "analysis/selection"):
+        shutil.copytree(smoke_run / "results/smoke" / part, run / part)
+    command = ["snakemake", "--cores", "2", "--config", "scale=smoke", "overrides=env.fps=50", "run=fps",
+               "--rerun-triggers", "mtime", "--directory", str(work), "--snakefile", str(work / "Snakefile"),
+               "figures/fps/fig3.png", "figures/fps/fig5.png"]
+    result = subprocess.run(command, capture_output=True, text=True, timeout=1200, env=smoke_env(work))
+    assert result.returncode == 0, result.stderr[-3000:]
+    assert "rule train" not in result.stdout + result.stderr  # the copied seeds were reused
+
+    recorded = pd.read_parquet(run / "assays/patchy4/conditions.parquet")
+    assert (recorded["fps"] == 50).all()
+    tables = load_tables(PANELS["fig3/O"], run, seeds=2)
+    ax = draw_panel_axes("fig3/O", tables)
+    plotted = sorted(float(y) for c in ax.collections for _, y in c.get_offsets())
+    expected = sorted(tables["eod_probability"].dropna(subset=["size", "eod_probability"])["eod_probability"] * 50)
+    assert plotted and plotted == pytest.approx(expected)
+
+    configs = assay_conditions(load_tables(PANELS["fig5/E"], run, seeds=2), "onepatch")
+    assert configs["A_lt_B"].env.sizes == [0.5, 0.75] and configs["A_lt_B"].env.fps == 50
+    assert matched_alone(configs)["A", "A_lt_B"] == "A_alone_50"  # the files here would say A_alone_25

@@ -1,8 +1,8 @@
-# Analyses (SPEC 12): one rule per analysis of efish.analysis.registry, one job per (analysis, assay), writing
-# results/{run}/analysis/<analysis>/{assay}/<table>.parquet (the registry declares every table). The DAG asks
-# for the analyses of each assay of the scale whose input tables that assay writes (common.smk: ASSAY_ANALYSES).
-# The same rule per analysis, named top_seed_analysis_<analysis>, runs on a top seed's rerun assays into
-# results/{run}/seeds/seed_{seed}/analysis/ (the analyses the claims read there; common.smk: seed_analysis_assays).
+# Analyses: one rule per analysis of efish.analysis.registry, one job per (analysis, assay), writing the tables the
+# registry declares (efish.layout.analysis_table). The DAG asks for the analyses of each assay of the scale whose
+# input tables that assay writes (common.smk: ASSAY_ANALYSES). The same rule per analysis, named
+# top_seed_analysis_<analysis>, runs on a top seed's rerun assays in its copy of the layout (the analyses the
+# claims read there; common.smk: seed_analysis_assays).
 
 
 for analysis in ANALYSES.values():
@@ -17,9 +17,9 @@ for analysis in ANALYSES.values():
             output:
                 **analysis_outputs(analysis, seed=seed),
             log:
-                f"results/{{run}}/logs/{seed_folder(seed)}analysis/{analysis.name}/{{assay}}.log",
+                log(f"analysis/{analysis.name}/{{assay}}", seed),
             benchmark:
-                f"results/{{run}}/benchmarks/{seed_folder(seed)}analysis/{analysis.name}/{{assay}}.tsv"
+                benchmark(f"analysis/{analysis.name}/{{assay}}", seed)
             params:
                 overrides=ARGS,
                 analysis=analysis.name,
@@ -27,9 +27,7 @@ for analysis in ANALYSES.values():
                 out=folder_of(analysis.outputs[0]),
             wildcard_constraints:
                 assay="|".join(assays),
-            threads: 1
             conda:
                 "../envs/efish.yaml"
             shell:
-                "efish analyze {params.analysis} assay={wildcards.assay} {params.overrides} "
-                "--tables {params.tables} --out {params.out} > {log} 2>&1"
+                efish("analyze {params.analysis}", "assay={wildcards.assay} --tables {params.tables} --out {params.out}")

@@ -1,67 +1,62 @@
-# Assays (SPEC 11): one job per assay writes its steps, episodes and food tables (and hidden.parquet where the
+# Assays: one job per assay writes its steps, episodes, food and conditions tables (and hidden.parquet where the
 # assay sets record_hidden). An assay is a file config/assay/<name>.yaml; each condition's `assay.policy` says which
 # trained policy acts (the selected seed, or a recipe of config/policy/), and the job gets every one it needs.
+
+
+def assay_outputs(hidden, seed=None):
+    """The tables an assay job writes, by name (hidden: the assay records the GRU state), in top seed ``seed``'s
+    copy of the layout if given."""
+    names = [*ROLLOUT_TABLES, *(["hidden"] if hidden else [])]
+    return {t: results(assay_table("{assay}", t), seed) for t in names}
 
 
 rule assay:
     input:
         unpack(assay_policies_input),
     output:
-        steps="results/{run}/assays/{assay}/steps.parquet",
-        episodes="results/{run}/assays/{assay}/episodes.parquet",
-        food="results/{run}/assays/{assay}/food.parquet",
+        **assay_outputs(hidden=False),
     log:
-        "results/{run}/logs/assays/{assay}.log",
+        log("assays/{assay}"),
     benchmark:
-        "results/{run}/benchmarks/assays/{assay}.tsv"
+        benchmark("assays/{assay}")
     params:
         overrides=ARGS,
         out=folder_of("steps"),
         policies=policy_args,
     wildcard_constraints:
         assay="|".join(a for a in ASSAYS if a not in HIDDEN_ASSAYS) or "^$",
-    threads: 1
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish assay assay={wildcards.assay} {params.overrides} --policy {params.policies} "
-        "--out {params.out} > {log} 2>&1"
+        efish("assay", "assay={wildcards.assay} --policy {params.policies} --out {params.out}")
 
 
 use rule assay as assay_with_hidden with:
     output:
-        steps="results/{run}/assays/{assay}/steps.parquet",
-        episodes="results/{run}/assays/{assay}/episodes.parquet",
-        food="results/{run}/assays/{assay}/food.parquet",
-        hidden="results/{run}/assays/{assay}/hidden.parquet",
+        **assay_outputs(hidden=True),
     wildcard_constraints:
         assay="|".join(HIDDEN_ASSAYS) or "^$",
 
 
 # The best-ranked seeds (scale.top_seeds, from the select_seed checkpoint's ranking) rerun assays with their own
-# checkpoint as the `selected` policy, into results/{run}/seeds/seed_{seed}/assays/{assay}/ (the layout of
-# results/{run}/assays/): every top seed runs scale.top_seed_assays for the supplement's top-seed panels, and each
-# top seed other than the selected one also runs every claim's assay (common.smk: SEED_CLAIM_ASSAYS) for its own
-# claims table. The selected seed's rules, whose inputs (assay_policies_input) read {seed}.
+# checkpoint as the `selected` policy, each in its own copy of the layout (efish.layout.Run.top_seed): every top
+# seed runs scale.top_seed_assays for the supplement's top-seed panels, and each top seed other than the selected
+# one also runs every claim's assay (common.smk: SEED_CLAIM_ASSAYS) for its own claims table. The selected seed's
+# rules, whose inputs (assay_policies_input) read {seed}.
 use rule assay as top_seed_assay with:
     output:
-        steps="results/{run}/seeds/seed_{seed}/assays/{assay}/steps.parquet",
-        episodes="results/{run}/seeds/seed_{seed}/assays/{assay}/episodes.parquet",
-        food="results/{run}/seeds/seed_{seed}/assays/{assay}/food.parquet",
+        **assay_outputs(hidden=False, seed="{seed}"),
     log:
-        "results/{run}/logs/seeds/seed_{seed}/{assay}.log",
+        log("assays/{assay}", seed="{seed}"),
     benchmark:
-        "results/{run}/benchmarks/seeds/seed_{seed}/{assay}.tsv"
+        benchmark("assays/{assay}", seed="{seed}")
     wildcard_constraints:
         assay="|".join(a for a in TOP_SEED_ASSAYS if a not in TOP_SEED_HIDDEN) or "^$",
 
 
 use rule top_seed_assay as top_seed_assay_with_hidden with:
     output:
-        steps="results/{run}/seeds/seed_{seed}/assays/{assay}/steps.parquet",
-        episodes="results/{run}/seeds/seed_{seed}/assays/{assay}/episodes.parquet",
-        food="results/{run}/seeds/seed_{seed}/assays/{assay}/food.parquet",
-        hidden="results/{run}/seeds/seed_{seed}/assays/{assay}/hidden.parquet",
+        **assay_outputs(hidden=True, seed="{seed}"),
     wildcard_constraints:
         assay="|".join(TOP_SEED_HIDDEN) or "^$",
 
@@ -70,15 +65,16 @@ use rule top_seed_assay as top_seed_assay_with_hidden with:
 rule top_seeds:
     input:
         tables=top_seed_tables,
-        ranking="results/{run}/analysis/selection/ranking.parquet",
+        ranking=results(RANKING),
     output:
-        "results/{run}/seeds/{assay}/episodes.parquet",
+        results(stacked_seeds_table("{assay}")),
     log:
-        "results/{run}/logs/seeds/{assay}.log",
-    conda:
-        "../envs/efish.yaml"
+        log("seeds/{assay}"),
+    benchmark:
+        benchmark("seeds/{assay}")
     params:
         overrides=ARGS,
+    conda:
+        "../envs/efish.yaml"
     shell:
-        "efish stack-seeds {params.overrides} --tables {input.tables} --ranking {input.ranking} --out {output} "
-        "> {log} 2>&1"
+        efish("stack-seeds", "--tables {input.tables} --ranking {input.ranking} --out {output}")

@@ -1,83 +1,58 @@
-# Speed and accuracy studies of the physics core.
+# Speed and accuracy studies of the physics core: each writes its table under the run's bench/ folder and its
+# figure (if it has one) under the run's figures (efish.layout).
 
 
 rule bench_physics:
     output:
-        "results/{run}/bench/bench_physics.json",
+        results(bench_file("bench_physics.json")),
     log:
-        "results/{run}/logs/bench_physics.log",
+        log("bench_physics"),
     benchmark:
-        "results/{run}/benchmarks/bench_physics.tsv"
+        benchmark("bench_physics")
     params:
         overrides=ARGS,
         out=folder_of(0),
-    threads: 1
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish bench physics {params.overrides} --out {params.out} > {log} 2>&1"
+        efish("bench physics", "--out {params.out}")
 
 
 rule bench_accuracy:
     output:
-        table="results/{run}/bench/bench_accuracy.parquet",
-        figure="results/{run}/bench/bench_accuracy.png",
+        table=results(bench_file("bench_accuracy.parquet")),
+        png=report(str(RULE_RUN.bench_figure("bench_accuracy", "png")), caption="../report/bench_accuracy.rst",
+                   category="Benchmarks"),
+        pdf=str(RULE_RUN.bench_figure("bench_accuracy", "pdf")),
     log:
-        "results/{run}/logs/bench_accuracy.log",
+        log("bench_accuracy"),
     benchmark:
-        "results/{run}/benchmarks/bench_accuracy.tsv"
+        benchmark("bench_accuracy")
     params:
         overrides=ARGS,
         out=folder_of("table"),
-    threads: 1
+        figures=folder_of("png"),
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish bench accuracy {params.overrides} --out {params.out} > {log} 2>&1"
-
-
-rule figure_bench_accuracy:
-    input:
-        "results/{run}/bench/bench_accuracy.parquet",
-    output:
-        png=report(
-            "figures/{run}/bench/bench_accuracy.png",
-            caption="../report/bench_accuracy.rst",
-            category="Benchmarks",
-        ),
-        pdf="figures/{run}/bench/bench_accuracy.pdf",
-    log:
-        "results/{run}/logs/figure_bench_accuracy.log",
-    benchmark:
-        "results/{run}/benchmarks/figures/bench_accuracy.tsv"
-    params:
-        overrides=ARGS,
-        out=folder_of("png", up=1),
-    conda:
-        "../envs/efish.yaml"
-    shell:
-        "efish figure bench/accuracy {params.overrides} --results results/{wildcards.run} --out {params.out} "
-        "> {log} 2>&1"
+        efish("bench accuracy", "--out {params.out} --figures {params.figures}")
 
 
 rule bench_scaling:
     output:
-        table="results/{run}/bench/bench_scaling.parquet",
-        png=report(
-            "results/{run}/bench/bench_scaling.png",
-            caption="../report/bench_scaling.rst",
-            category="Benchmarks",
-        ),
-        pdf="results/{run}/bench/bench_scaling.pdf",
+        table=results(bench_file("bench_scaling.parquet")),
+        png=report(str(RULE_RUN.bench_figure("bench_scaling", "png")), caption="../report/bench_scaling.rst",
+                   category="Benchmarks"),
+        pdf=str(RULE_RUN.bench_figure("bench_scaling", "pdf")),
     log:
-        "results/{run}/logs/bench_scaling.log",
+        log("bench_scaling"),
     benchmark:
-        "results/{run}/benchmarks/bench_scaling.tsv"
+        benchmark("bench_scaling")
     params:
         overrides=ARGS,
         out=folder_of("table"),
-    threads: 1
+        figures=folder_of("png"),
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish bench scaling {params.overrides} --out {params.out} > {log} 2>&1"
+        efish("bench scaling", "--out {params.out} --figures {params.figures}")

@@ -8,7 +8,6 @@ import shlex
 import sys
 from pathlib import Path
 
-from efish.analysis.claim_parts import analysis_table
 from efish.analysis.claims import claim_tables, produced_tables
 from efish.analysis.registry import ANALYSES, analyses_for, tables_written
 from efish._numba_cache import source_digest
@@ -17,6 +16,23 @@ from efish.env.observe import observation_size
 from efish.rollout.assay import check_observation_sizes, condition_configs, policies_needed
 from efish.figures.registry import PANELS, drawable
 from efish.figures.render import input_paths
+from efish.layout import (
+    CLAIMS_PAGE,
+    CLAIMS_TABLE,
+    FIGURE_FORMATS,
+    ROLLOUT_TABLES,
+    RANKING,
+    SELECTED_SEED,
+    Run,
+    analysis_table,
+    assay_table,
+    bench_file,
+    scene_table,
+    seed_name,
+    selection_table,
+    stacked_seeds_table,
+    training_file,
+)
 
 CONFIG_KEYS = ("scale", "overrides", "run")
 
@@ -104,7 +120,7 @@ DRAWABLE = drawable(CFG.scale)
 
 
 def claims_read(names):
-    """The tables the claims read among those assays ``names`` write, as paths under ``results/{run}/``."""
+    """The tables the claims read among those assays ``names`` write, as paths relative to a run's results."""
     produced = produced_tables({name: assay_config(name).assay for name in names})
     return [path for path in claim_tables() if path in produced]
 
@@ -116,9 +132,12 @@ def claims_read(names):
 # are "not run" for the other seeds.
 SEED_CLAIM_ASSAYS = [name for name in ASSAYS if "selected" in ASSAY_POLICIES[name] and claims_read([name])]
 SEED_CLAIM_TABLES = claims_read(SEED_CLAIM_ASSAYS)
-# Every assay a top seed may run under results/{run}/seeds/seed_{n}/assays/: the claims' and the supplement's.
+# Every assay a top seed may run (in its copy of the layout): the claims' and the supplement's.
 TOP_SEED_ASSAYS = sorted({*SEED_CLAIM_ASSAYS, *CFG.scale.top_seed_assays})
 TOP_SEED_HIDDEN = [name for name in TOP_SEED_ASSAYS if assay_config(name).assay.record_hidden]
+
+
+CLIP_ASSAYS = [name for name in CFG.scale.clip_assays if name in ASSAYS]
 
 
 wildcard_constraints:
@@ -127,28 +146,48 @@ wildcard_constraints:
     assay=r"[A-Za-z0-9_\-]+",
 
 
+# ------------------------------------------------------------------ paths: every one from efish.layout
+RULE_RUN = Run("{run}")  # the rules' patterns ({run} and the rule's other wildcards)
+THIS_RUN = Run(RUN)  # this run's own files (rule all, panel inputs)
+
+
+def results(relative, seed=None, run=RULE_RUN):
+    """A file under the run's results folder (or top seed ``seed``'s copy of it) from a relative name of
+    efish.layout, e.g. ``results(assay_table("{assay}", "steps"))``."""
+    return str((run if seed is None else run.top_seed(seed)).path(relative))
+
+
+def log(job, seed=None):
+    """The job's log file, results/{run}/logs/<job>.log (a top seed's under logs/seeds/seed_<n>/)."""
+    return str((RULE_RUN if seed is None else RULE_RUN.top_seed(seed)).log(job))
+
+
+def benchmark(job, seed=None):
+    """The job's Snakemake timing file, results/{run}/benchmarks/<job>.tsv (read by efish bench pipeline)."""
+    return str((RULE_RUN if seed is None else RULE_RUN.top_seed(seed)).benchmark(job))
+
+
+def efish(command, arguments=""):
+    """The shell line of an efish call: the (sub)command, the run's overrides (params.overrides) right after it,
+    the rule's own arguments, and the output into the job's log. Every rule runs efish this way, so none repeats
+    the redirection or the overrides (which come before options such as --seed-claims that take many values)."""
+    return f"efish {command} {{params.overrides}} {arguments} > {{log}} 2>&1"
+
+
 def folder_of(name, up=0):
     """A params function: the folder of output ``name`` (a name or an index), or the folder ``up`` levels
     above it. It is what efish's ``--out`` takes, so no rule repeats an output path."""
     return lambda wildcards, output: str(Path(output[name]).parents[up])
 
 
-def seed_folder(seed=None):
-    """Where a top seed other than the selected one keeps the layout of results/{run}/: '' for the run's own
-    (the selected seed's) outputs, 'seeds/seed_<seed>/' for another seed's (``seed`` may be '{seed}')."""
-    return "" if seed is None else f"seeds/seed_{seed}/"
-
-
 def analysis_inputs(analysis, seed=None):
     """The rollout tables an analysis reads, by name, for the {assay} wildcard (of top seed ``seed``)."""
-    return {t: f"results/{{run}}/{seed_folder(seed)}assays/{{assay}}/{t}.parquet" for t in analysis.reads}
+    return {t: results(assay_table("{assay}", t), seed) for t in analysis.reads}
 
 
-def analysis_outputs(analysis, run="{run}", assay="{assay}", seed=None):
-    """The tables an analysis writes, by name: results/{run}/analysis/<analysis>/{assay}/<table>.parquet, or
-    results/{run}/seeds/seed_<seed>/analysis/... for another top seed."""
-    return {t: f"results/{run}/{seed_folder(seed)}analysis/{analysis.name}/{assay}/{t}.parquet"
-            for t in analysis.outputs}
+def analysis_outputs(analysis, run=RULE_RUN, assay="{assay}", seed=None):
+    """The tables an analysis writes, by name (under top seed ``seed``'s copy of the layout if given)."""
+    return {t: results(analysis_table(analysis.name, assay, t), seed, run) for t in analysis.outputs}
 
 
 def seed_analysis_assays(analysis):
@@ -159,25 +198,27 @@ def seed_analysis_assays(analysis):
 
 def panel_inputs(panel):
     """Every table a panel reads, at this scale (the same expansion efish figure uses)."""
-    return [str(path) for paths in input_paths(panel, Path(f"results/{RUN}"), len(SEEDS)).values() for path in paths]
+    return [str(path) for paths in input_paths(panel, THIS_RUN.results, len(SEEDS)).values() for path in paths]
 
 
-def selected_policy(wildcards):
-    """The final checkpoint of the seed the select_seed checkpoint chose."""
-    chosen = checkpoints.select_seed.get(run=wildcards.run).output.seed
-    seed = int(Path(chosen).read_text().strip())
-    return f"results/{wildcards.run}/train/seed_{seed}/final.pt"
+def seed_policy(wildcards, seed):
+    return results(training_file(seed_name(seed), "final.pt"), run=Run(wildcards.run))
+
+
+def selected_seed(wildcards):
+    """The seed the select_seed checkpoint chose."""
+    return int(Path(checkpoints.select_seed.get(run=wildcards.run).output.seed).read_text().strip())
 
 
 def assay_policies_input(wildcards):
     """The final checkpoint of every policy an assay's conditions act with, by policy name. The ``selected`` policy
-    is the seed the select_seed checkpoint chose, or seed {seed} for a top seed's run (results/{run}/seeds/)."""
+    is the seed the select_seed checkpoint chose, or seed {seed} for a top seed's rerun."""
     seed = getattr(wildcards, "seed", None)
 
     def path(name):
         if name != "selected":
-            return f"results/{wildcards.run}/train/{name}/final.pt"
-        return selected_policy(wildcards) if seed is None else f"results/{wildcards.run}/train/seed_{seed}/final.pt"
+            return results(training_file(name, "final.pt"), run=Run(wildcards.run))
+        return seed_policy(wildcards, selected_seed(wildcards) if seed is None else seed)
 
     return {name: path(name) for name in ASSAY_POLICIES.get(wildcards.assay, ["selected"])}
 
@@ -197,78 +238,66 @@ def top_seeds(wildcards):
 
 def other_top_seeds(wildcards):
     """The top seeds other than the selected one (the ranking's first row), best first: each reruns every claim's
-    assay under results/{run}/seeds/seed_{n}/ for its own claims table."""
+    assay in its own copy of the layout for its own claims table."""
     return top_seeds(wildcards)[1:]
 
 
 def other_seed_claims(wildcards):
     """The claims tables of the other top seeds, in ranking order (the claims rule combines them)."""
-    return [f"results/{wildcards.run}/seeds/seed_{seed}/claims/claims.parquet" for seed in other_top_seeds(wildcards)]
+    return [results(CLAIMS_TABLE, seed, Run(wildcards.run)) for seed in other_top_seeds(wildcards)]
 
 
 def seed_claims_args(wildcards, input):
     """efish claims's --ranking and --seed-claims SEED=PATH of the other top seeds (none: the selected seed alone)."""
-    pairs = [f"{seed}={path}" for seed, path in zip(other_top_seeds(wildcards), other_seed_claims(wildcards))]
+    pairs = [f"{seed}={path}" for seed, path in zip(other_top_seeds(wildcards), other_seed_claims(wildcards),
+                                                    strict=True)]
     return " ".join([f"--ranking {input.ranking} --seed-claims", *pairs])
 
 
 def top_seed_tables(wildcards):
-    """The episodes tables of the top seeds in assay {assay} (supplement): results/{run}/seeds/seed_{n}/assays/."""
-    return [f"results/{wildcards.run}/seeds/seed_{seed}/assays/{wildcards.assay}/episodes.parquet"
-            for seed in top_seeds(wildcards)]
-
-
-def panel_of(wildcards):
-    """The registered panel named by the wildcards; an unknown one is one clear error."""
-    key = f"{wildcards.figure}/{wildcards.panel}"
-    if key not in PANELS:
-        fail(f"unknown panel {key!r}: choose one of {', '.join(PANELS)}")
-    return PANELS[key]
-
-
-# The assays whose clips the report shows (issue 15): homing, foraging in the patchy and the wide arena, the
-# resident and the intruder at one patch.
-CLIP_ASSAYS = [name for name in ("homing", "patchy4", "wide2", "onepatch") if name in ASSAYS]
-
-
-def clip_condition(wildcards):
-    """The clip's condition: the first of the assay's config (config/assay/<name>.yaml)."""
-    return next(iter(assay_config(wildcards.assay).assay.conditions))
-
-
-def render_targets():
-    """The clips and the contact sheet of this run (for rule all)."""
-    return [f"figures/{RUN}/clips/{name}.gif" for name in CLIP_ASSAYS] + [f"figures/{RUN}/contact_sheet.png"]
+    """The episodes tables of the top seeds in assay {assay} (stacked for the supplement)."""
+    return [results(assay_table(wildcards.assay, "episodes"), seed, Run(wildcards.run)) for seed in top_seeds(wildcards)]
 
 
 def claims_inputs(wildcards):
     """The claims' tables among those the assays of this scale write (rollout tables and their analyses); for a top
-    seed's claims (wildcard {seed}) those its rerun assays write under results/{run}/seeds/seed_{seed}/."""
+    seed's claims (wildcard {seed}) those its rerun assays write in its copy of the layout."""
     seed = getattr(wildcards, "seed", None)
     paths = claims_read(ASSAYS) if seed is None else SEED_CLAIM_TABLES
-    return [f"results/{wildcards.run}/{seed_folder(seed)}{path}" for path in paths]
+    return [results(path, seed, Run(wildcards.run)) for path in paths]
+
+
+# ------------------------------------------------------------------ figures
+# One job per figure draws each of its panels (PNG, PDF) and its page from the same tables.
+FIGURE_PANELS = {}
+for _panel in DRAWABLE:
+    FIGURE_PANELS.setdefault(_panel.figure, []).append(_panel)
+
+
+def figure_outputs(figure, run=RULE_RUN):
+    """Every file a figure's job writes: each panel's PNG and PDF, then the page's."""
+    panels = [run.panel(figure, p.name, ext) for p in FIGURE_PANELS[figure] for ext in FIGURE_FORMATS]
+    return [str(path) for path in panels + [run.page(figure, ext) for ext in FIGURE_FORMATS]]
+
+
+def render_targets():
+    """The clips and the contact sheet of this run (for rule all)."""
+    return [str(THIS_RUN.clip(name)) for name in CLIP_ASSAYS] + [str(THIS_RUN.contact_sheet)]
 
 
 def all_targets():
     """Every final output of the pipeline for this run."""
-    targets = [
-        f"results/{RUN}/bench/bench_physics.json",
-        f"results/{RUN}/bench/bench_accuracy.parquet",
-        f"figures/{RUN}/bench/bench_accuracy.png",
-        f"figures/{RUN}/bench/bench_accuracy.pdf",
-        f"results/{RUN}/bench/bench_scaling.parquet",
-        f"results/{RUN}/bench/bench_scaling.png",
-        f"results/{RUN}/bench/bench_scaling.pdf",
-    ]
-    targets += [f"results/{RUN}/assays/{a}/{t}.parquet" for a in ASSAYS for t in ("steps", "episodes", "food")]
-    targets += [f"results/{RUN}/assays/{a}/hidden.parquet" for a in HIDDEN_ASSAYS]
+    targets = [results(bench_file(name), run=THIS_RUN) for name in
+               ("bench_physics.json", "bench_accuracy.parquet", "bench_scaling.parquet")]
+    targets += [str(THIS_RUN.bench_figure(name, ext)) for name in ("bench_accuracy", "bench_scaling")
+                for ext in FIGURE_FORMATS]
+    targets += [results(assay_table(a, t), run=THIS_RUN) for a in ASSAYS for t in ROLLOUT_TABLES]
+    targets += [results(assay_table(a, "hidden"), run=THIS_RUN) for a in HIDDEN_ASSAYS]
     if CFG.scale.top_seeds:
-        targets += [f"results/{RUN}/seeds/{assay}/episodes.parquet" for assay in CFG.scale.top_seed_assays]
+        targets += [results(stacked_seeds_table(assay), run=THIS_RUN) for assay in CFG.scale.top_seed_assays]
     targets += [path for a, analyses in ASSAY_ANALYSES.items() for an in analyses
-                for path in analysis_outputs(an, RUN, a).values()]
-    targets += [f"figures/{RUN}/{p.figure}/{p.name}.{ext}" for p in DRAWABLE for ext in ("png", "pdf")]
-    pages = {p.figure for p in DRAWABLE}
-    targets += [f"figures/{RUN}/{fig}.{ext}" for fig in sorted(pages) for ext in ("png", "pdf")]
+                for path in analysis_outputs(an, THIS_RUN, a).values()]
+    targets += [path for figure in FIGURE_PANELS for path in figure_outputs(figure, THIS_RUN)]
     targets += render_targets()
-    targets += [f"results/{RUN}/claims/claims.parquet", f"results/{RUN}/claims/claims.md"]
+    targets += [results(CLAIMS_TABLE, run=THIS_RUN), results(CLAIMS_PAGE, run=THIS_RUN)]
     return targets

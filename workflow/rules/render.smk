@@ -1,44 +1,40 @@
-# Episode clips and the contact sheet: one clip of the first episode of the first condition of each assay in
-# CLIP_ASSAYS that the scale runs (efish render), and one page of every panel's thumbnail (efish contact-sheet).
+# Episode clips and the contact sheet: one clip of the first episode of the first condition of each assay of
+# scale.clip_assays that the scale runs (efish render), and one page of every panel's thumbnail
+# (efish contact-sheet).
 
 
 rule render_clip:
     input:
-        steps="results/{run}/assays/{assay}/steps.parquet",
-        food="results/{run}/assays/{assay}/food.parquet",
+        steps=results(assay_table("{assay}", "steps")),
+        food=results(assay_table("{assay}", "food")),
+        conditions=results(assay_table("{assay}", "conditions")),
     output:
-        report(
-            "figures/{run}/clips/{assay}.gif",
-            caption="../report/clip.rst",
-            category="Episodes",
-            labels={"assay": "{assay}"},
-        ),
+        report(str(RULE_RUN.clip("{assay}")), caption="../report/clip.rst", category="Episodes",
+               labels={"assay": "{assay}"}),
     log:
-        "results/{run}/logs/render/{assay}.log",
+        log("render/{assay}"),
     benchmark:
-        "results/{run}/benchmarks/render/{assay}.tsv"
+        benchmark("render/{assay}")
     params:
         overrides=ARGS,
-        condition=clip_condition,
         tables=lambda wildcards, input: str(Path(input.steps).parent),
     wildcard_constraints:
         assay="|".join(CLIP_ASSAYS) or "^$",
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish render assay={wildcards.assay} {params.overrides} --condition {params.condition:q} "
-        "--tables {params.tables} --out {output} > {log} 2>&1"
+        efish("render", "assay={wildcards.assay} --tables {params.tables} --out {output}")
 
 
 rule contact_sheet:
     input:
-        [f"figures/{{run}}/{p.figure}/{p.name}.png" for p in DRAWABLE],
+        [str(RULE_RUN.panel(p.figure, p.name, "png")) for p in DRAWABLE],
     output:
-        report("figures/{run}/contact_sheet.png", caption="../report/contact_sheet.rst", category="Contact sheet"),
+        report(str(RULE_RUN.contact_sheet), caption="../report/contact_sheet.rst", category="Contact sheet"),
     log:
-        "results/{run}/logs/render/contact_sheet.log",
+        log("render/contact_sheet"),
     benchmark:
-        "results/{run}/benchmarks/render/contact_sheet.tsv"
+        benchmark("render/contact_sheet")
     params:
         overrides=ARGS,
         figures=folder_of(0),
@@ -47,4 +43,4 @@ rule contact_sheet:
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish contact-sheet {params.overrides} --figures {params.figures} --out {output} > {log} 2>&1"
+        efish("contact-sheet", "--figures {params.figures} --out {output}")

@@ -1,21 +1,20 @@
 # Field maps of Fig 1 and the sensing-range supplement, computed by the physics (config/scene/<scene>.yaml).
-# Panels read results/{run}/scenes/<scene>.parquet, so the panel rule asks for the scenes it draws.
+# Panels read the scenes' tables (efish.layout.scene_table), so a figure's job asks for the scenes it draws.
 
 
 rule scene:
     output:
-        "results/{run}/scenes/{scene}.parquet",
+        results(scene_table("{scene}")),
     log:
-        "results/{run}/logs/scenes/{scene}.log",
+        log("scenes/{scene}"),
     benchmark:
-        "results/{run}/benchmarks/scenes/{scene}.tsv"
+        benchmark("scenes/{scene}")
     params:
         overrides=ARGS,
         out=folder_of(0),
     wildcard_constraints:
         scene=r"[A-Za-z0-9_\-]+",
-    threads: 1
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish scene {wildcards.scene} {params.overrides} --out {params.out} > {log} 2>&1"
+        efish("scene {wildcards.scene}", "--out {params.out}")

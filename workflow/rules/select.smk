@@ -1,43 +1,39 @@
-# Seed selection (SPEC 10): every seed on held-out patchy episodes, then a
-# checkpoint rule ranks them; the assays read the chosen seed from its output.
+# Seed selection: every seed on held-out patchy episodes, then a checkpoint rule ranks them; the assays read the
+# chosen seed from its output.
 
 
 rule evaluate_seed:
     input:
-        "results/{run}/train/seed_{seed}/final.pt",
+        results(training_file(seed_name("{seed}"), "final.pt")),
     output:
-        "results/{run}/selection/seed_{seed}/episodes.parquet",
-        "results/{run}/selection/seed_{seed}/steps.parquet",
-        "results/{run}/selection/seed_{seed}/food.parquet",
+        [results(selection_table("{seed}", t)) for t in ("episodes", "steps", "food", "conditions")],
     log:
-        "results/{run}/logs/selection/seed_{seed}.log",
+        log(f"selection/{seed_name('{seed}')}"),
     benchmark:
-        "results/{run}/benchmarks/selection/seed_{seed}.tsv"
+        benchmark(f"selection/{seed_name('{seed}')}")
     params:
         overrides=ARGS,
         out=folder_of(0),
-    threads: 1
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish assay assay=selection {params.overrides} --policy {input} "
-        "--out {params.out} > {log} 2>&1"
+        efish("assay", "assay=selection --policy {input} --out {params.out}")
 
 
 checkpoint select_seed:
     input:
-        expand("results/{{run}}/selection/seed_{seed}/episodes.parquet", seed=SEEDS),
+        expand(results(selection_table("{seed}", "episodes")), seed=SEEDS, allow_missing=True),
     output:
-        ranking="results/{run}/analysis/selection/ranking.parquet",
-        seed="results/{run}/analysis/selection/selected_seed.txt",
+        ranking=results(RANKING),
+        seed=results(SELECTED_SEED),
     log:
-        "results/{run}/logs/select_seed.log",
+        log("select_seed"),
     benchmark:
-        "results/{run}/benchmarks/select_seed.tsv"
+        benchmark("select_seed")
     params:
         overrides=ARGS,
         out=folder_of("ranking"),
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish select {params.overrides} --episodes {input} --out {params.out} > {log} 2>&1"
+        efish("select", "--episodes {input} --out {params.out}")

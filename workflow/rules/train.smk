@@ -6,39 +6,35 @@
 
 rule train:
     output:
-        final="results/{run}/train/seed_{seed}/final.pt",
-        metrics="results/{run}/train/seed_{seed}/metrics.parquet",
+        final=results(training_file(seed_name("{seed}"), "final.pt")),
+        metrics=results(training_file(seed_name("{seed}"), "metrics.parquet")),
     log:
-        "results/{run}/logs/train/seed_{seed}.log",
+        log(f"train/{seed_name('{seed}')}"),
     benchmark:
-        "results/{run}/benchmarks/train/seed_{seed}.tsv"
+        benchmark(f"train/{seed_name('{seed}')}")
     params:
         overrides=ARGS,
         out=folder_of("final"),
-    threads: 1
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish train train.seed={wildcards.seed} train.threads={threads} "
-        "{params.overrides} --out {params.out} > {log} 2>&1"
+        efish("train", "train.seed={wildcards.seed} train.threads={threads} --out {params.out}")
 
 
 rule train_policy:
     output:
-        final="results/{run}/train/{policy}/final.pt",
-        metrics="results/{run}/train/{policy}/metrics.parquet",
+        final=results(training_file("{policy}", "final.pt")),
+        metrics=results(training_file("{policy}", "metrics.parquet")),
     log:
-        "results/{run}/logs/train/{policy}.log",
+        log("train/{policy}"),
     benchmark:
-        "results/{run}/benchmarks/train/{policy}.tsv"
+        benchmark("train/{policy}")
     params:
         overrides=ARGS,
         out=folder_of("final"),
     wildcard_constraints:
         policy="|".join(POLICY_RECIPES),
-    threads: 1
     conda:
         "../envs/efish.yaml"
     shell:
-        "efish train policy={wildcards.policy} train.threads={threads} "
-        "{params.overrides} --out {params.out} > {log} 2>&1"
+        efish("train", "policy={wildcards.policy} train.threads={threads} --out {params.out}")

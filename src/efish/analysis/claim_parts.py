@@ -38,6 +38,7 @@ import pandas as pd
 from scipy import stats as sps
 
 from ..config.schema import EfishConfig
+from ..layout import parse_table
 from ._tables import AGENT_EPISODE
 from .claim_stats import (
     at_ceiling,
@@ -59,9 +60,9 @@ class MissingTable(LookupError):
     """A table a claim needs is not in the results folder; the message names it and its assay."""
 
     def __init__(self, path: str):
-        parts = path.split("/")
-        what = (f"assay {parts[1]}" if parts[0] == "assays" else
-                f"analysis {parts[1]} of assay {parts[2]}" if parts[0] == "analysis" and len(parts) > 3 else path)
+        table = parse_table(path)
+        what = (path if table is None else f"assay {table.assay}" if table.kind == "assays"
+                else f"analysis {table.analysis} of assay {table.assay}")
         super().__init__(f"needs {path}, which this run lacks ({what} has not run at this scale)")
 
 
@@ -324,16 +325,6 @@ def markdown_table(frame: pd.DataFrame) -> str:
 
 # ------------------------------------------------------- claims and their context
 Tables = Mapping[str, pd.DataFrame]
-
-
-def analysis_table(analysis: str, assay: str, table: str) -> str:
-    """Path of an analysis table under ``results/{run}/``."""
-    return f"analysis/{analysis}/{assay}/{table}.parquet"
-
-
-def rollout_table(assay: str, table: str) -> str:
-    """Path of a rollout table under ``results/{run}/``."""
-    return f"assays/{assay}/{table}.parquet"
 
 
 # ------------------------------------------------------------------ context

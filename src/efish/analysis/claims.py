@@ -29,6 +29,7 @@ from scipy import stats as sps
 
 from ..config.schema import AssayConfig, EfishConfig
 from ..io import read_parquet
+from ..layout import analysis_table, assay_table
 from . import claims_fig4  # noqa: F401  (registers C10-C13)
 from ._tables import AGENT_EPISODE, eod_rate
 from .claim_parts import (
@@ -37,7 +38,6 @@ from .claim_parts import (
     Context,
     Outcome,
     Part,
-    analysis_table,
     claim,
     from_row,
     heldout_skill,
@@ -51,7 +51,6 @@ from .claim_parts import (
     paired_difference,
     present,
     rho_of,
-    rollout_table,
     slope,
     spearman_part,
     stat_row,
@@ -73,7 +72,7 @@ __all__ = ["CLAIMS", "ROW_COLUMNS", "claim_tables", "claims_table", "produced_ta
 # --------------------------------------------------------------- Fig 2
 HOMING_ELECTRIC, HOMING_RAYCAST = "electric", "raycast"  # config/assay/homing.yaml
 TRAJECTORY = analysis_table("homing", "homing", "trajectory_shape")
-HOMING_STEPS, HOMING_HIDDEN = rollout_table("homing", "steps"), rollout_table("homing", "hidden")
+HOMING_STEPS, HOMING_HIDDEN = assay_table("homing", "steps"), assay_table("homing", "hidden")
 
 
 def _successful(frame: pd.DataFrame) -> pd.DataFrame:
@@ -183,8 +182,8 @@ def c4(ctx: Context) -> list[Part]:
                      "IDIs in steps >= xmin (wide2; powerlaw discrete=True, as the authors); powerlaw's p", compute)]
 
 
-WIDE2_STEPS, WIDE2_HIDDEN = rollout_table("wide2", "steps"), rollout_table("wide2", "hidden")
-WIDE2_EPISODES = rollout_table("wide2", "episodes")
+WIDE2_STEPS, WIDE2_HIDDEN = assay_table("wide2", "steps"), assay_table("wide2", "hidden")
+WIDE2_EPISODES = assay_table("wide2", "episodes")
 
 
 def _kruskal_eta(d: pd.DataFrame) -> tuple[float, float, int]:
@@ -358,7 +357,7 @@ def c15(ctx: Context) -> list[Part]:
                      "(onepatch reach_tests)", functools.partial(_reach, ctx, "eod"))]
 
 
-SQUARE2_STEPS = rollout_table("square2", "steps")
+SQUARE2_STEPS = assay_table("square2", "steps")
 
 
 def _confronting(ctx: Context) -> Outcome:
@@ -594,7 +593,7 @@ def produced_tables(assays: Mapping[str, AssayConfig]) -> set[str]:
     out = set()
     for name, assay in assays.items():
         written = tables_written(assay)
-        out |= {rollout_table(name, t) for t in written}
+        out |= {assay_table(name, t) for t in written}
         out |= {analysis_table(a.name, name, t) for a in ANALYSES.values()
                 if name in a.assays and set(a.reads) <= set(written) for t in a.outputs}
     return out

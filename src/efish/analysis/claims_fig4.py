@@ -19,11 +19,11 @@ import re
 import numpy as np
 import pandas as pd
 
+from ..layout import analysis_table, assay_table
 from .claim_parts import (
     Context,
     Outcome,
     Part,
-    analysis_table,
     ceiling,
     claim,
     mann_whitney_part,
@@ -31,7 +31,6 @@ from .claim_parts import (
     mean_diff,
     paired_part,
     present,
-    rollout_table,
     spearman_part,
 )
 from .claim_stats import excess_theil_per_episode, welch_tost
@@ -54,7 +53,7 @@ def _vs_control(ctx: Context, assay: str, condition: str, control: str, measure:
     if family is not None:
         s = s[s["condition"].isin([*family, control])]
     if measure == FOOD:
-        if (at := ceiling(ctx, s, ctx.table(rollout_table(assay, "food")), [control])) is not None:
+        if (at := ceiling(ctx, s, ctx.table(assay_table(assay, "food")), [control])) is not None:
             return at
     if measure == "bites" and s.loc[s["condition"].isin([condition, control]), "bites"].sum() == 0:
         return Outcome(np.nan, np.nan, 0, None, verdict="not decidable",
@@ -73,7 +72,7 @@ def _parts(ctx: Context, assay: str, control: str, specs, decides: bool = True,
 
 def _tables(assays, tables=("episode_summary",)) -> list[str]:
     return ([analysis_table("behaviour", a, t) for a in assays for t in tables]
-            + [rollout_table(a, "food") for a in assays])
+            + [assay_table(a, "food") for a in assays])
 
 
 @claim("C10", "4A-F", "short-range ablations cut food; Knollenorgan ablation keeps food, raises EOD probability "

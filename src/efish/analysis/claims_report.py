@@ -12,6 +12,7 @@ import numpy as np
 import pandas as pd
 
 from ..io import read_parquet
+from ..layout import CLAIMS_TABLE, RESULTS_ROOT, Run
 from .claim_parts import VERDICTS, markdown_table
 
 
@@ -41,14 +42,14 @@ def claims_markdown(table: pd.DataFrame, header: str) -> str:
     return f"{header}\n\n{summary}.\n\n{markdown_table(shown)}"
 
 
-def load_claims(where: str | Path, results_root: str | Path = "results") -> tuple[str, pd.DataFrame]:
+def load_claims(where: str | Path, results_root: str | Path = RESULTS_ROOT) -> tuple[str, pd.DataFrame]:
     """A claims table and its run's name from a claims.parquet path, a claims folder, or a run name.
 
     A run name ``NAME`` means ``<results_root>/NAME/claims/claims.parquet``.
     ValueError (one line) when none of these is a file.
     """
     where = Path(where)
-    candidates = [where, where / "claims.parquet", Path(results_root) / where / "claims" / "claims.parquet"]
+    candidates = [where, where / "claims.parquet", Run(str(where), results_root=Path(results_root)).path(CLAIMS_TABLE)]
     path = next((c for c in candidates if c.is_file()), None)
     if path is None:
         raise ValueError(f"no claims table for {str(where)!r}: tried {', '.join(map(str, candidates))} "

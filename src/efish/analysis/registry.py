@@ -26,6 +26,7 @@ import pandas as pd
 
 from ..config.schema import AssayConfig, EfishConfig
 from ..io import read_parquet
+from ..layout import ROLLOUT_TABLES
 from ._tables import nan_frame, or_nan_row, require
 from .behaviour import (
     bite_matrix,
@@ -59,7 +60,6 @@ from .stats import STAT_COLUMNS, dunnett_by_measure, spearman
 
 Tables = dict[str, pd.DataFrame]
 #: Tables every assay writes; ``hidden`` only with ``assay.record_hidden`` (a key the assays issue adds).
-ROLLOUT_TABLES = ("steps", "episodes", "food")
 #: Per-episode measures of :func:`efish.analysis.behaviour.episode_summary` compared between conditions.
 SUMMARY_MEASURES = ["food_total", "theil_t", "eod_probability", "mean_nn_dist_cm", "bites"]
 #: Per-agent-episode measures of :func:`efish.analysis.dynamics.dynamics_table` compared between conditions.
@@ -276,7 +276,8 @@ def get(name: str) -> Analysis:
 
 
 def tables_written(assay: AssayConfig) -> tuple[str, ...]:
-    """The rollout tables an assay writes: steps, episodes, food, and hidden when it sets ``record_hidden``."""
+    """The rollout tables an assay writes: steps, episodes, food, conditions, and hidden when it sets
+    ``record_hidden``."""
     return ROLLOUT_TABLES + (("hidden",) if getattr(assay, "record_hidden", False) else ())
 
 

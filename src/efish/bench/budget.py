@@ -1,7 +1,8 @@
 """``efish bench budget``: what a fixed training time buys, a wider network, more env steps or more seeds.
 
-Every width of ``--hidden`` trains ``--seeds`` seeds (1, 2, ...) for the same
-wall time, ``--jobs`` runs at a time with one torch thread each, as the
+Every width of ``bench.budget_hidden`` (``--hidden``) trains ``bench.budget_seeds``
+(``--seeds``) seeds (1, 2, ...) for the same wall time (``bench.budget_minutes``),
+``bench.budget_jobs`` (``--jobs``) runs at a time with one torch thread each, as the
 workflow's training jobs run. Each run's metrics (``wall_s``, ``env_steps``,
 ``episode_return`` per update) are kept, so one set of runs answers three
 questions at equal cost, the cost of one seed trained for the whole budget:
@@ -81,12 +82,26 @@ def check_budget(hiddens: tuple[int, ...], seeds: int, minutes: float, jobs: int
                          f"minutes={minutes}, seeds={seeds}, jobs={jobs}, widths={list(hiddens)}")
 
 
-def bench_budget(cfg: EfishConfig, hiddens: tuple[int, ...], seeds: int, minutes: float, jobs: int = 2,
-                 progress=None) -> pd.DataFrame:
+def budget_sizes(cfg: EfishConfig) -> tuple[tuple[int, ...], int, float, int]:
+    """(widths, seeds, minutes, jobs) of ``cfg.bench``, checked (:func:`check_budget`)."""
+    b = cfg.bench
+    sizes = (tuple(b.budget_hidden), b.budget_seeds, b.budget_minutes, b.budget_jobs)
+    check_budget(*sizes)
+    return sizes
+
+
+def bench_budget(cfg: EfishConfig, hiddens: tuple[int, ...] | None = None, seeds: int | None = None,
+                 minutes: float | None = None, jobs: int | None = None, progress=None) -> pd.DataFrame:
     """Train every (width, seed) for ``minutes``; one row per run and checkpoint time (budget / seeds and budget).
+    A size left None is ``cfg.bench``'s (``budget_hidden``, ``budget_seeds``, ``budget_minutes``, ``budget_jobs``).
 
     Columns: hidden, seed, fraction (of the budget), wall_s, env_steps, episode_return.
     """
+    b = cfg.bench
+    hiddens = tuple(b.budget_hidden if hiddens is None else hiddens)
+    seeds = b.budget_seeds if seeds is None else seeds
+    minutes = b.budget_minutes if minutes is None else minutes
+    jobs = b.budget_jobs if jobs is None else jobs
     check_budget(hiddens, seeds, minutes, jobs)
     seconds = 60.0 * minutes
     train_for(cfg, min(hiddens), 1, 0.0)  # one update here first compiles the numba kernels for every run

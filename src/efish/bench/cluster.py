@@ -39,6 +39,7 @@ import yaml
 from ..config import compose
 from ..config.schema import EfishConfig
 from ..env.observe import observation_size
+from ..layout import BENCHMARKS
 from .train import forward_flops
 
 HEADROOM = 1.5  # the profile's runtime and memory must cover this many times the estimate
@@ -247,7 +248,7 @@ def plan_cluster(overrides: list[str], source_scale: str, results: Path, profile
                  dry_run_text: str | None = None) -> pd.DataFrame:
     """Every job of the workflow at ``overrides`` (its dry run, or ``dry_run_text``), estimated from the benchmark
     files of the ``source_scale`` run in ``results`` and checked against ``profile``."""
-    measured = read_benchmarks(Path(results) / "benchmarks")
+    measured = read_benchmarks(Path(results) / BENCHMARKS)
     jobs = parse_dry_run(dry_run_text if dry_run_text is not None else dry_run(overrides))
     if not jobs:
         raise ValueError("the dry run lists no jobs")

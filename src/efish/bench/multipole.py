@@ -215,14 +215,17 @@ def _scene_sources(cfg: EfishConfig, width_cm: float) -> tuple[np.ndarray, np.nd
     return xy, lst[L_A2].copy(), batch.agent_xy[0] * CM, box, tables
 
 
-def bench_multipole(cfg: EfishConfig, orders: tuple[int, ...] = (4, 6, 8), width_cm: float = 560.0,
+def bench_multipole(cfg: EfishConfig, orders: tuple[int, ...] | None = None, width_cm: float | None = None,
                     repeats: int = 20) -> pd.DataFrame:
     """One row per (order, agent): the measured per-point costs and the quadtree's cells and cost at that agent.
+    ``orders`` and ``width_cm`` default to ``bench.multipole_orders`` and ``bench.multipole_width_cm``.
 
     Columns: order, agent, cell_ns (per cell and point), direct_ns (per source and
     point), cells, direct_sources, sources, quadtree_us and direct_us (one agent's
     Ampullary far field at the first far level's points, from those costs).
     """
+    orders = tuple(cfg.bench.multipole_orders if orders is None else orders)
+    width_cm = cfg.bench.multipole_width_cm if width_cm is None else width_cm
     if not orders or min(orders) < 0:
         raise ValueError(f"orders must be non-negative and at least one, got {list(orders)}")
     if width_cm <= 0:

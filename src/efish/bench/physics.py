@@ -8,7 +8,7 @@ from ..config.schema import EfishConfig
 from ..physics.plan import build_plan
 from ..sensors.sense import sense_batch
 from .scenes import benchmark_batch
-from .timing import best_time, best_times_interleaved
+from .timing import best_time, best_times_interleaved, machine, machine_line
 
 READING_KEYS = ("mormyromast", "ampullary", "knollenorgan", "knollen_size")
 
@@ -22,7 +22,8 @@ def bench_physics(cfg: EfishConfig) -> dict:
     """Time the fast path and the reference on the benchmark scenes; one thread.
 
     Returns agent-steps/s of both, their ratio and the max |difference| of
-    normalised readings (fast at the configured tolerance vs reference).
+    normalised readings (fast at the configured tolerance vs reference), with
+    the CPU's ``cpu`` and ``cpu_capability``.
     """
     bc = cfg.bench
     batch = benchmark_batch(cfg, bc.scenes, bc.seed)
@@ -44,12 +45,12 @@ def bench_physics(cfg: EfishConfig) -> dict:
         "snapshots": b, "tolerance": plan.tolerance, "dtype": plan.dtype, "image_order": cfg.physics.image_order,
         "fast_agent_steps_per_s": fast_rate, "reference_agent_steps_per_s": ref_rate,
         "speedup": fast_rate / ref_rate, "max_abs_diff_normalised": diff,
-        "fast_us_per_agent_step": 1e6 / fast_rate, "reference_us_per_agent_step": 1e6 / ref_rate,
+        "fast_us_per_agent_step": 1e6 / fast_rate, "reference_us_per_agent_step": 1e6 / ref_rate, **machine(),
     }
 
 
 def format_physics(r: dict) -> str:
-    """The result as an aligned table."""
+    """The result as an aligned table under the machine's line."""
     rows = [
         ("scene", r["scene"]), ("snapshots", r["snapshots"]),
         ("dtype / tolerance / image order", f"{r['dtype']} / {r['tolerance']:g} / {r['image_order']}"),
@@ -59,4 +60,4 @@ def format_physics(r: dict) -> str:
         ("max |fast - reference| (normalised)", f"{r['max_abs_diff_normalised']:.2e}"),
     ]
     width = max(len(k) for k, _ in rows)
-    return "\n".join(f"{k:<{width}}  {v}" for k, v in rows)
+    return "\n".join([machine_line(r), *(f"{k:<{width}}  {v}" for k, v in rows)])

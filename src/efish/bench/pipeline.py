@@ -11,6 +11,8 @@ from pathlib import Path
 
 import pandas as pd
 
+from ..layout import BENCHMARKS
+
 COLUMNS = ("group", "jobs", "total_s", "max_s", "max_rss_mb")
 
 
@@ -22,7 +24,7 @@ def job_group(path: Path, root: Path) -> str:
 
 def pipeline_timings(results: Path) -> pd.DataFrame:
     """One row per rule family: number of jobs, summed and largest wall time (s), largest resident memory."""
-    root = Path(results) / "benchmarks"
+    root = Path(results) / BENCHMARKS
     files = sorted(root.glob("**/*.tsv"))
     if not files:
         raise ValueError(f"no Snakemake benchmark files under {root}: run the pipeline first")

@@ -19,6 +19,27 @@ def cpu_name() -> str:
     return platform.processor() or "unknown CPU"
 
 
+def cpu_capability() -> str:
+    """The instruction set torch's CPU kernels use here (``AVX2``, ``AVX512``, ...): it decides, among others, whether
+    bf16 matrix products run at fp32's speed or far below it."""
+    import torch
+
+    try:
+        return torch.backends.cpu.get_cpu_capability()
+    except AttributeError:  # a torch older than 2.0
+        return "unknown"
+
+
+def machine() -> dict[str, str]:
+    """The CPU's model name and torch capability, the keys a benchmark's rows carry beside its numbers."""
+    return {"cpu": cpu_name(), "cpu_capability": cpu_capability()}
+
+
+def machine_line(info: dict) -> str:
+    """One line naming the machine of :func:`machine`'s ``info``, printed above a benchmark's table."""
+    return f"CPU: {info.get('cpu', '?')} (torch CPU capability {info.get('cpu_capability', '?')})"
+
+
 def best_time(fn: Callable[[], object], repeats: int, warmup: bool = True) -> float:
     """Fastest of ``repeats`` calls in seconds (after one warm-up call that also compiles)."""
     if warmup:

@@ -54,17 +54,30 @@ def cache_folder() -> Path | None:
     return base / "compose"
 
 
-def _inputs_digest(tree: Path) -> str:
-    """Digest of everything a composition reads: the config tree's files, this package's config sources and the
-    Hydra and OmegaConf versions. Computed afresh each time (a few ms): a tree edited between two compositions of
-    one process must not be served the first result."""
+def _sources_digest() -> str:
+    """Digest of this package's config sources (the schema the composed dataclasses come from) and the Hydra and
+    OmegaConf versions, taken once, when this module is imported: a process whose schema.py was edited after it
+    started still builds configs of the schema it loaded, so its cache entries must carry that schema's key."""
     import hydra
     import omegaconf
 
     digest = hashlib.sha256(f"hydra {hydra.__version__} omegaconf {omegaconf.__version__}".encode())
-    sources = sorted(Path(__file__).parent.glob("*.py"))
-    for path in [*sorted(p for p in tree.rglob("*") if p.is_file()), *sources]:
-        digest.update(str(path.relative_to(tree if path.is_relative_to(tree) else path.parent)).encode())
+    for path in sorted(Path(__file__).parent.glob("*.py")):
+        digest.update(path.name.encode())
+        digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+_SOURCES_DIGEST = _sources_digest()
+
+
+def _inputs_digest(tree: Path) -> str:
+    """Digest of everything a composition reads: the config tree's files (computed afresh each time, a few ms: a
+    tree edited between two compositions of one process must not be served the first result) and the sources
+    this process loaded (:data:`_SOURCES_DIGEST`)."""
+    digest = hashlib.sha256(_SOURCES_DIGEST.encode())
+    for path in sorted(p for p in tree.rglob("*") if p.is_file()):
+        digest.update(str(path.relative_to(tree)).encode())
         digest.update(path.read_bytes())
     return digest.hexdigest()
 

@@ -224,14 +224,16 @@ class EnvConfig:
 # ----------------------------------------------------------------------- train
 @dataclass
 class TrainConfig:
-    """Recurrent MAPPO (SPEC 9)."""
+    """Recurrent MAPPO (SPEC 9). The sizes (hidden, epochs, num_envs, rollout_steps, chunk, total_steps) read the
+    scale by interpolation, so their one copy is in :class:`ScaleConfig` and config/scale/*.yaml; a resolved
+    config (:func:`~efish.config.compose`) holds numbers."""
 
-    hidden: int = param(512, "width of every layer and of the GRU", lo=1, hi=8192)
+    hidden: int = param("${scale.hidden}", "width of every layer and of the GRU", lo=1, hi=8192)
     head_gain: float = param(0.01, "orthogonal init gain of the output heads", lo=0.0)
     lr: float = param(5e-4, "Adam learning rate (actor and critic)", lo=0.0, hi=1.0)
     adam_eps: float = param(1e-5, "Adam epsilon", lo=0.0)
     weight_decay: float = param(1e-6, "Adam weight decay", lo=0.0)
-    epochs: int = param(15, "PPO epochs per update", lo=1)
+    epochs: int = param("${scale.epochs}", "PPO epochs per update", lo=1)
     minibatches: int = param(1, "minibatches per epoch (split over sequences)", lo=1)
     micro_sequences: int = param(256, "sequences per forward/backward pass; a minibatch's gradients are summed "
                                       "over these micro-batches before its one optimiser step (same update, "
@@ -243,11 +245,11 @@ class TrainConfig:
     max_grad_norm: float = param(10.0, "gradient norm clip", lo=0.0)
     gamma: float = param(0.995, "discount", lo=0.0, hi=1.0)
     gae_lambda: float = param(0.95, "GAE lambda", lo=0.0, hi=1.0)
-    num_envs: int = param(16, "parallel arenas per rollout", lo=1)
-    rollout_steps: int = param(1600, "steps per rollout", lo=1)
-    chunk: int = param(100, "BPTT chunk length; must divide rollout_steps", lo=1)
-    total_steps: int = param(5_000_000, "env steps per seed (arena steps x arenas); a longer run resumes a shorter "
-                                        "one's checkpoint", lo=1, neutral=True)
+    num_envs: int = param("${scale.num_envs}", "parallel arenas per rollout", lo=1)
+    rollout_steps: int = param("${scale.rollout_steps}", "steps per rollout", lo=1)
+    chunk: int = param("${scale.chunk}", "BPTT chunk length; must divide rollout_steps", lo=1)
+    total_steps: int = param("${scale.train_steps}", "env steps per seed (arena steps x arenas); a longer run "
+                             "resumes a shorter one's checkpoint", lo=1, neutral=True)
     checkpoint_every: int = param(10, "updates between checkpoints", lo=1, neutral=True)
     threads: int = param(1, "torch threads", lo=1, hi=256, neutral=True)
     precision: str = param("auto", "arithmetic of the update's forward passes: fp32, bf16 autocast, or auto (time "
@@ -257,7 +259,6 @@ class TrainConfig:
                                 "fp32 (near ties keep fp32's numerics)", lo=1.0, neutral=True)
     device: str = param("cpu", "where the networks and the PPO update run (cuda: a GPU node); a resumed run may "
                         "switch", choices=("cpu", "cuda"), neutral=True)
-    bf16: bool = param(False, "retired: use train.precision (true stops with that advice)")
     seed: int = param(1, "training seed", lo=0)
 
 
@@ -279,7 +280,7 @@ class AssayConfig:
 # ----------------------------------------------------------------------- bench
 @dataclass
 class BenchConfig:
-    """Sizes of the physics benchmarks and the accuracy-vs-time study."""
+    """Sizes of the benchmarks (``efish bench ...``); a command's flags, where it has them, override these."""
 
     scenes: int = param(64, "benchmark snapshots (4-agent 70x70 patchy)", lo=1)
     repeats: int = param(7, "timing repeats; the fastest is reported (this VM is noisy)", lo=1)
@@ -300,6 +301,20 @@ class BenchConfig:
     scaling_envs: int = param(16, "bench scaling: arenas stepped together", lo=1)
     scaling_agent_steps: int = param(2048, "bench scaling: agent-steps per timed call of the fast path", lo=1)
     scaling_exact_agent_steps: int = param(64, "bench scaling: agent-steps per timed call at tolerance 0", lo=1)
+    env_envs: int = param(16, "bench env: arenas stepped together (--envs)", lo=1)
+    env_steps: int = param(100, "bench env: timed steps of the fast path (--steps)", lo=1)
+    train_hidden: list = param([512, 64], "bench train: network widths timed (--hidden)")
+    train_skip_below: float = param(0.25, "bench train: a precision whose training-shape GEMM runs below this "
+                                    "fraction of the fastest precision's is not timed, and its row says why: a slow "
+                                    "path (bf16 on a CPU without AVX-512 runs ~50x below fp32) would take hours on a "
+                                    "paper-size update to confirm what train.precision=auto already decided; 0 times "
+                                    "every precision", lo=0.0, hi=1.0)
+    budget_minutes: float = param(10.0, "bench budget: wall time of each training run, minutes (--minutes)", lo=0.0)
+    budget_hidden: list = param([64, 128], "bench budget: network widths trained (--hidden)")
+    budget_seeds: int = param(2, "bench budget: seeds per width (--seeds)", lo=1)
+    budget_jobs: int = param(2, "bench budget: runs at a time, one thread each (--jobs)", lo=1)
+    multipole_orders: list = param([4, 6, 8], "bench multipole: expansion orders compared (--orders)")
+    multipole_width_cm: float = param(560.0, "bench multipole: square arena side of the scene, cm (--width)", lo=0.0)
 
 
 @dataclass
@@ -322,6 +337,8 @@ class ScaleConfig:
     top_seeds: int = param(3, "the best-ranked seeds (the selected one first): the others rerun every claim's assays "
                            "for seeds_agree, and all run the top_seed_assays (supplement)", lo=0)
     top_seed_assays: list = param(["patchy4", "wide2", "square2"], "assays the top seeds run")
+    clip_assays: list = param(["homing", "patchy4", "wide2", "onepatch"], "assays whose first episode the report "
+                              "shows as a clip (efish render), those of them the scale runs")
     assays: list = param(["homing", "patchy4", "uniform4", "wide2", "square2", "ablation4", "ablation1",
                           "collective", "mute", "npatch", "food_scarcity", "onepatch", "bot", "groupsize"],
                          "assays the pipeline runs (names of config/assay/*.yaml)")
@@ -505,8 +522,6 @@ def _check_consistency(obj: Any, path: str) -> None:
     """Cross-field rules that a single range cannot express."""
     if isinstance(obj, AssayConfig) and not obj.conditions:
         raise ConfigError(f"{path}conditions is empty: an assay needs at least one condition")
-    if isinstance(obj, TrainConfig) and obj.bf16:
-        raise ConfigError(f"{path}bf16 is retired: set {path}precision=bf16 (or auto, fp32) instead")
     if isinstance(obj, TrainConfig) and obj.rollout_steps % obj.chunk:
         raise ConfigError(f"{path}chunk={obj.chunk} must divide {path}rollout_steps={obj.rollout_steps}")
     if isinstance(obj, EnvConfig):

@@ -16,14 +16,15 @@ from __future__ import annotations
 
 import math
 import shutil
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from ..config import EfishConfig
+from ..config.recorded import recorded_conditions
+from ..config.schema import EfishConfig
 from ..io import atomic_path, read_parquet
 from .style import HEATMAP_CMAP, NEUTRAL_COLOUR, PELLET_COLOUR, agent_colour, panel_style
 
@@ -44,8 +45,8 @@ WRITERS = {".gif": "pillow", ".mp4": "ffmpeg"}
 
 @dataclass(frozen=True)
 class Episode:
-    """One episode of one condition, as arrays over (frame step, agent); ``cfg`` is the condition's config
-    (arena size, fps, physics of the field overlay)."""
+    """One episode of one condition, as arrays over (frame step, agent); ``cfg`` is the condition's config as the
+    run recorded it (arena size, fps, physics of the field overlay)."""
 
     assay: str
     condition: str
@@ -79,16 +80,21 @@ class Episode:
 def load_episode(tables: Path, overrides: Sequence[str], cfg: EfishConfig, condition: str | None = None,
                  episode: int | None = None) -> Episode:
     """Episode ``episode`` of ``condition`` of the assay in ``cfg`` from ``tables/steps.parquet`` and
-    ``food.parquet``; ``condition`` defaults to the assay's first, ``episode`` to the condition's first.
-    ``overrides`` composed ``cfg``; the condition's own overrides are applied on top of them."""
-    paths = {name: Path(tables) / f"{name}.parquet" for name in ("steps", "food")}
+    ``food.parquet``, drawn with the condition's config as the run recorded it in ``tables/conditions.parquet``
+    (with every override the run had); ``condition`` defaults to the assay's first, ``episode`` to the
+    condition's first. ``cfg`` names the assay the tables must be; ``overrides`` is not used any more (nothing is
+    composed: the record is the run's) and stays for the callers that pass it."""
+    del overrides  # the recorded conditions carry the run's overrides
+    tables = Path(tables)
+    paths = {name: tables / f"{name}.parquet" for name in ("steps", "food")}
     absent = [str(p) for p in paths.values() if not p.is_file()]
     if absent:
         raise ValueError(f"missing rollout table(s) {', '.join(absent)}: run efish assay first or pass --tables")
-    check_assay(Path(tables), cfg.assay.name)
+    check_assay(tables, cfg.assay.name)
+    configs = recorded_assay(tables, cfg.assay.name)
     steps = read_parquet(paths["steps"], "a steps table")
     food = read_parquet(paths["food"], "a food table")
-    condition = condition if condition is not None else next(iter(cfg.assay.conditions), None)
+    condition = condition if condition is not None else next(iter(configs), None)
     held = list(dict.fromkeys(steps["condition"]))
     if condition not in held:
         raise ValueError(f"unknown condition {condition!r}: the tables in {tables} hold "
@@ -100,7 +106,7 @@ def load_episode(tables: Path, overrides: Sequence[str], cfg: EfishConfig, condi
         raise ValueError(f"condition {condition} has no episode {episode}: it has episodes {spans(episodes)}")
     return episode_from_tables(rows[rows["episode"] == episode],
                                food[(food["condition"] == condition) & (food["episode"] == episode)],
-                               condition_config(overrides, cfg, condition), condition, episode)
+                               condition_config(configs, cfg.assay.name, condition), condition, episode)
 
 
 def check_assay(tables: Path, assay: str) -> None:
@@ -117,15 +123,29 @@ def check_assay(tables: Path, assay: str) -> None:
                          f"pass assay={written}")
 
 
-def condition_config(overrides: Sequence[str], cfg: EfishConfig, condition: str) -> EfishConfig:
-    """The config of one condition of the assay (arena size, agents, physics differ between conditions)."""
-    from ..config.compose import compose_variants
+def recorded_assay(tables: Path, assay: str) -> dict[str, EfishConfig]:
+    """Condition -> its config as the run resolved it, in the assay's order, from ``tables/conditions.parquet``
+    (written by efish assay beside steps and food). The record must be assay ``assay``'s: another assay's arena
+    would put every body in the wrong place."""
+    path = Path(tables) / "conditions.parquet"
+    if not path.is_file():
+        raise ValueError(f"missing {path}: the clip draws each condition as the run recorded it, and these tables "
+                         "were written before efish assay recorded its conditions: rerun the assay")
+    configs = dict(recorded_conditions(read_parquet(path, "a conditions table"), str(path)))
+    written = {c.assay.name for c in configs.values()}
+    if written and written != {assay}:
+        raise ValueError(f"the tables in {tables} are assay {', '.join(sorted(written))}'s (its conditions.parquet), "
+                         f"not {assay}'s: pass assay={min(written)}")
+    return configs
 
-    if condition not in cfg.assay.conditions:
-        raise ValueError(f"condition {condition!r} is not one of assay {cfg.assay.name}'s conditions "
-                         f"({', '.join(cfg.assay.conditions)}): pass the assay of these tables (assay=<name>)")
-    return compose_variants(list(overrides), {condition: cfg.assay.conditions[condition]},
-                            label=f"assay {cfg.assay.name}, condition")[condition]
+
+def condition_config(configs: Mapping[str, EfishConfig], assay: str, condition: str) -> EfishConfig:
+    """The recorded config of one condition of the assay (arena size, agents, physics differ between
+    conditions); ``configs`` is :func:`recorded_assay`'s."""
+    if condition not in configs:
+        raise ValueError(f"condition {condition!r} is not one of assay {assay}'s recorded conditions "
+                         f"({', '.join(configs)}): pass the assay of these tables (assay=<name>)")
+    return configs[condition]
 
 
 def episode_from_tables(steps: pd.DataFrame, food: pd.DataFrame, cfg: EfishConfig, condition: str,

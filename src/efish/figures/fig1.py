@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from .. import layout
 from ..config.schema import AnalysisConfig, EnvConfig, SensorsConfig
 from . import schematics as sk
 from .panel import Panel
@@ -25,7 +26,7 @@ TRAIL_STEPS = 40  # panel H: steps of path drawn behind each agent
 
 def scene_input(name: str) -> dict[str, str]:
     """A panel's input: the scene table ``scenes/<name>.parquet``."""
-    return {"scene": f"scenes/{name}.parquet"}
+    return {"scene": layout.scene_table(name)}
 
 
 # ------------------------------------------------------------------- scene rows
@@ -433,7 +434,8 @@ PANELS: list[Panel] = [
     Panel("fig1", "G", full_scene, scene_input("full_scene"), "A scene with every element: two emitting fish "
           "(+/- poles), a silent one, pellets, walls, the summed EOD field (log10 |E|) with field lines and the focal fish's eating "
           "cone; table scenes/full_scene.parquet (efish scene full_scene)."),
-    Panel("fig1", "H", snapshot_raster, {"steps": "assays/patchy4/steps.parquet", "food": "assays/patchy4/food.parquet"},
+    Panel("fig1", "H", snapshot_raster, {"steps": layout.assay_table("patchy4", "steps"),
+                                         "food": layout.assay_table("patchy4", "food")},
           "One patchy4 episode (first condition and episode): positions, recent paths and live pellets at its middle "
           "step, and the EOD raster of every agent; tables assays/patchy4/steps.parquet and food.parquet."),
     Panel("supp", "sensing_range", sensing_range, scene_input("sensing_range"), "Detection range of each receptor "

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from .. import layout
 from .panel import Panel
 from .style import RECEPTOR_COLOURS, condition_palette, finite, missing, stars_for
 
@@ -132,20 +133,24 @@ def error_vs_time(tables: dict[str, pd.DataFrame], ax) -> None:
     ax.legend(loc="best", fontsize=6)
 
 
-HOMING = "assays/homing/steps.parquet"
-ANALYSIS = "analysis/homing/homing"
+HOMING = layout.assay_table("homing", "steps")
+
+
+def _analysis(table: str) -> str:
+    return layout.analysis_table("homing", "homing", table)
+
 
 PANELS = [
     Panel("fig2", "A", scene, {"steps": HOMING},
           "Homing assay (SPEC 11): start positions of the homer (dots) and the frozen, always-emitting target "
           "(star; the arrow is its heading, the axis of its dipole) in the electric test episodes; homing steps table."),
-    Panel("fig2", "B", trajectories, {"steps": HOMING, "perception": f"{ANALYSIS}/perception.parquet"},
+    Panel("fig2", "B", trajectories, {"steps": HOMING, "perception": _analysis("perception")},
           "Homing trajectories of the homer, electric senses (solid) vs ray casting (dashed), homing assay; stars: "
           "Mann-Whitney test of tortuosity (path length / displacement) from the homing analysis's perception table."),
-    Panel("fig2", "C", error_polar, {"error_histogram": f"{ANALYSIS}/error_histogram.parquet"},
+    Panel("fig2", "C", error_polar, {"error_histogram": _analysis("error_histogram")},
           "Polar density of the error angle (heading minus the local direction of the target's field) per receptor "
           "class, electric homer, homing assay; homing analysis's error_histogram table.", projection="polar"),
-    Panel("fig2", "D", error_vs_time, {"error_vs_time": f"{ANALYSIS}/error_vs_time.parquet"},
+    Panel("fig2", "D", error_vs_time, {"error_vs_time": _analysis("error_vs_time")},
           "Mean absolute error angle (+- SEM) against normalised episode time per receptor class, electric homer; "
           "the dotted line is the mean of a uniform angle (pi/2); homing analysis's error_vs_time table."),
 ]

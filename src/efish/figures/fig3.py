@@ -4,7 +4,8 @@ Assays (SPEC 11): the two-agent wide arena ``wide2`` for the signalling panels
 C-J, the four-agent patchy arena ``patchy4`` for the ethogram, trajectories
 and the size panels (A, B, K-P). Every panel reads analysis tables (or, for
 the trajectories, the rollout tables) and takes its tests from the analyses'
-statistic tables; nothing here fits or tests anything. The assays have one
+statistic tables; nothing here fits or tests anything. The arena and the frame
+rate come from the conditions the run recorded (``conditions/<assay>``). The assays have one
 condition each (the selected seed's behaviour, drawn in SELECTED_COLOUR);
 should one have several, each is drawn in its own colour.
 """
@@ -12,11 +13,12 @@ should one have several, each is drawn in its own colour.
 from __future__ import annotations
 
 import textwrap
-from functools import cache
 
 import numpy as np
 import pandas as pd
 
+from .. import layout
+from ..config.schema import EfishConfig
 from .panel import Panel
 from .style import (
     CONDITION_COLOURS,
@@ -24,6 +26,7 @@ from .style import (
     NEUTRAL_COLOUR,
     SELECTED_COLOUR,
     agent_colour,
+    assay_conditions,
     condition_palette,
     corner_note,
     missing,
@@ -100,16 +103,17 @@ def _stat_text(stats: pd.DataFrame, symbol: str, **where) -> str:
     return f"{symbol} = {row['effect']:.2f}, {p} {stars_for(rows, **where)} (n = {int(row['n'])})"
 
 
-@cache
-def _assay_config(assay: str):
-    """The composed config of ``assay``: its arena (trajectory limits) and frame rate (Hz per EOD probability)."""
-    from ..config import compose
-
-    return compose([f"assay={assay}"])
+def _condition_config(tables: dict[str, pd.DataFrame], assay: str, condition) -> EfishConfig:
+    """The config the run recorded for ``condition`` of ``assay`` (its arena, its frame rate)."""
+    configs = assay_conditions(tables, assay)
+    if condition not in configs:
+        raise ValueError(f"condition {condition!r} of assay {assay} is not in its conditions table "
+                         f"({layout.assay_table(assay, 'conditions')} holds {', '.join(configs)}): rerun the assay")
+    return configs[condition]
 
 
 def _analysis(analysis: str, assay: str, table: str) -> str:
-    return f"analysis/{analysis}/{assay}/{table}.parquet"
+    return layout.analysis_table(analysis, assay, table)
 
 
 # ------------------------------------------------------------ A, B: patchy4
@@ -151,7 +155,7 @@ def trajectories(tables: dict[str, pd.DataFrame], ax) -> None:
         ax.plot(path["x_cm"].iloc[0], path["y_cm"].iloc[0], "o", color=colour, ms=3, zorder=3)
         eaten = pellets[pellets["eaten_by"] == agent]
         ax.scatter(eaten["x_cm"], eaten["y_cm"], s=10, marker="x", color=colour, linewidths=0.7, zorder=3)
-    arena = _assay_config(FORAGING).arena
+    arena = _condition_config(tables, FORAGING, condition).arena
     ax.set_xlim(0, arena.width_cm)
     ax.set_ylim(0, arena.height_cm)
     ax.set_aspect("equal")
@@ -424,12 +428,14 @@ def theil_vs_size_inequality(tables: dict[str, pd.DataFrame], ax) -> None:
 
 
 def eod_rate_vs_size(tables: dict[str, pd.DataFrame], ax) -> None:
-    """Panel O: mean EOD rate (EOD probability per step x the frame rate) per agent-episode against body
-    size, with the Spearman test of the behaviour size_tests table (measure ``eod_probability``)."""
+    """Panel O: mean EOD rate (EOD probability per step x the frame rate the run simulated the condition at)
+    per agent-episode against body size, with the Spearman test of the behaviour size_tests table (measure
+    ``eod_probability``)."""
     rows = _rows(ax, tables["eod_probability"], ["size", "eod_probability"], "patchy4 EOD probability")
     if rows is None:
         return
-    rows = rows.assign(rate_hz=rows["eod_probability"] * _assay_config(FORAGING).env.fps)
+    fps = {c: float(_condition_config(tables, FORAGING, c).env.fps) for c in rows["condition"].unique()}
+    rows = rows.assign(rate_hz=rows["eod_probability"] * rows["condition"].map(fps))
     _size_scatter(ax, rows, "size", "rate_hz")
     corner_note(ax, _stat_text(tables["size_tests"], "Spearman rho", measure="eod_probability"))
     ax.set_xlabel("body size")
@@ -466,8 +472,8 @@ PANELS = [
           "Ethogram: share of ordered pair-steps labelled confronting, chasing, fleeing, dispersing or unaligned "
           "(heading minus bearing to the partner, pi/4 and 3pi/4 thresholds), patchy4, "
           "analysis/interactions/patchy4/labels; descriptive, no test."),
-    Panel("fig3", "B", trajectories, {"steps": f"assays/{FORAGING}/steps.parquet",
-                                      "food": f"assays/{FORAGING}/food.parquet"},
+    Panel("fig3", "B", trajectories, {"steps": layout.assay_table(FORAGING, "steps"),
+                                      "food": layout.assay_table(FORAGING, "food")},
           "Trajectories of the four agents in the first patchy4 episode (line width grows with size), pellets "
           "grey, eaten pellets crossed in the eater's colour; raw rollout tables steps and food, no statistic."),
     Panel("fig3", "C", idi_histogram, {"idi_histogram": _SIG["idi_histogram"]},
@@ -509,7 +515,8 @@ PANELS = [
           f"analysis/behaviour/patchy4/theil; {_SIZE_TESTS} (measure theil_t) when the table holds it."),
     Panel("fig3", "O", eod_rate_vs_size, {"eod_probability": _BEH["eod_probability"],
                                           "size_tests": _BEH["size_tests"]},
-          "Mean EOD rate (EOD probability per step x 83 Hz) per agent-episode against body size, patchy4, "
+          "Mean EOD rate (EOD probability per step x the frame rate the run recorded, env.fps, 83 Hz by default) "
+          "per agent-episode against body size, patchy4, "
           f"analysis/behaviour/patchy4/eod_probability; {_SIZE_TESTS} (measure eod_probability)."),
     Panel("fig3", "P", rate_advantage, {"rate_advantage": _analysis("signalling", FORAGING, "rate_advantage"),
                                         "rate_tests": _analysis("signalling", FORAGING, "rate_tests")},

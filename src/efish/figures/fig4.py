@@ -13,10 +13,12 @@ says so.
 from __future__ import annotations
 
 import re
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 
 import pandas as pd
 
+from .. import layout
+from ..config.schema import EfishConfig
 from .panel import Panel, Tables
 from .style import (
     CONDITION_COLOURS,
@@ -86,11 +88,11 @@ def condition_box(assay: str, measure: str, title: str, label: Callable[[str], s
         summary, tests = tables["summary"], tables["tests"]
         controls = tests["control"].dropna().unique() if "control" in tests else []
         control = controls[0] if len(controls) else None
-        order = condition_order(assay, summary["condition"].dropna(), control)
+        order = condition_order(tables, assay, summary["condition"].dropna(), control)
         if not order:
             missing(ax, f"{assay} episode_summary has no condition")
             return
-        control = order[0] if control is None else control  # no test row: the config's first, as the analysis
+        control = order[0] if control is None else control  # no test row: the assay's first, as the analysis
         others = [c for c in order if c != control]
         palette = condition_palette(order, control)
         palette |= {c: tint(palette[base]) for c, base in (variants or {}).items() if c in palette and base in palette}
@@ -105,10 +107,9 @@ def condition_box(assay: str, measure: str, title: str, label: Callable[[str], s
     return draw
 
 
-def mute_design_labels() -> tuple[list[str], dict[str, str]]:
+def mute_design_labels(configs: Mapping[str, EfishConfig]) -> tuple[list[str], dict[str, str]]:
     """The x-axis label of each mute design (:data:`MUTE_DESIGNS`) and the tick label of each of its conditions,
-    from the conditions' configs (agents, food layout, arena size, who is muted)."""
-    configs = assay_conditions("mute")
+    from the mute assay's recorded conditions ``configs`` (agents, food layout, arena size, who is muted)."""
 
     def muted(cond: str) -> str:
         ids = configs[cond].env.muted
@@ -137,7 +138,7 @@ def mute_box(measure: str, title: str) -> Callable[[Tables, object], None]:
             return
         palette = {"": CONTROL_COLOUR, **{c: colour for intact, treated, _ in MUTE_DESIGNS
                                           for c, colour in ((intact, CONTROL_COLOUR), (treated, CONDITION_COLOURS[0]))}}
-        groups, labels = mute_design_labels()
+        groups, labels = mute_design_labels(assay_conditions(tables, "mute"))
         if not box_strip(ax, summary, "condition", measure, order, palette, labels=labels):
             return
         values = finite(summary.loc[summary["condition"].isin(order), measure])
@@ -210,9 +211,12 @@ def npatch_theil(tables: Tables, ax) -> None:
         ax.legend(title="food", loc="upper left", bbox_to_anchor=(1.0, 1.0))
 
 
+def _episode_summary(assay: str) -> str:
+    return layout.analysis_table("behaviour", assay, "episode_summary")
+
+
 def _summary(assay: str) -> dict[str, str]:
-    return {"summary": f"analysis/behaviour/{assay}/episode_summary.parquet",
-            "tests": f"analysis/behaviour/{assay}/condition_tests.parquet"}
+    return {"summary": _episode_summary(assay), "tests": layout.analysis_table("behaviour", assay, "condition_tests")}
 
 
 def _caption(what: str, assay: str, measure: str) -> str:
@@ -263,23 +267,21 @@ PANELS = [
     Panel("fig4", "J", mute_box("mean_nn_dist_cm", "Muting: spacing"), _summary("mute"),
           _mute_caption("mean_nn_dist_cm")),
     Panel("fig4", "K", layouts_box("food_total", "Patchy vs uniform: food"),
-          {"patchy": "analysis/behaviour/patchy4/episode_summary.parquet",
-           "uniform": "analysis/behaviour/uniform4/episode_summary.parquet"},
+          {"patchy": _episode_summary("patchy4"), "uniform": _episode_summary("uniform4")},
           "Food eaten per episode by four agents in the patchy (patchy4) and the uniform (uniform4) 70 x 70 cm "
           "arena, from analysis/behaviour/<assay>/episode_summary. No stars: the patchy-vs-uniform Mann-Whitney "
           "test is not in any analysis table."),
     Panel("fig4", "L", layouts_box("theil_t", "Patchy vs uniform: inequality"),
-          {"patchy": "analysis/behaviour/patchy4/episode_summary.parquet",
-           "uniform": "analysis/behaviour/uniform4/episode_summary.parquet"},
+          {"patchy": _episode_summary("patchy4"), "uniform": _episode_summary("uniform4")},
           "Theil T of food over the four agents per episode in the patchy4 and uniform4 assays, from "
           "analysis/behaviour/<assay>/episode_summary. No stars: the patchy-vs-uniform Mann-Whitney test is not "
           "in any analysis table."),
-    Panel("fig4", "M", npatch_food_ratio, {"summary": "analysis/behaviour/npatch/episode_summary.parquet"},
+    Panel("fig4", "M", npatch_food_ratio, {"summary": _episode_summary("npatch")},
           "N-patch sweep (npatch assay): food of each iso episode (fixed total food, multiplier 1/n) over the mean "
           "food of the free series (full food per patch) at the same number of patches n; line: mean +- SEM, from "
           "analysis/behaviour/npatch/episode_summary. No trend test: the Spearman of the ratio against n is not in "
           "any analysis table."),
-    Panel("fig4", "N", npatch_theil, {"summary": "analysis/behaviour/npatch/episode_summary.parquet"},
+    Panel("fig4", "N", npatch_theil, {"summary": _episode_summary("npatch")},
           "N-patch sweep (npatch assay): Theil T of food per episode against the number of patches, iso and free "
           "series; line: mean +- SEM, from analysis/behaviour/npatch/episode_summary. No trend test: the Spearman "
           "of Theil T against n is not in any analysis table."),

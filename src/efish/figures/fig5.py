@@ -1,25 +1,28 @@
 """Fig 5: the one-patch intruder assay, the bot, chasing and biting by size (SPEC 11, 13).
 
-Who is who comes from the assay configs, not from the condition names: the
+Who is who comes from the conditions the run recorded (``assays/<assay>/conditions.parquet``,
+read through :func:`~efish.figures.style.assay_conditions`), not from the condition names: the
 one-patch conditions set ``env.roles`` (``resident`` = A at the patch,
 ``intruder`` = B), and the bot conditions set the bot (``env.bots``), the
 size pair (``env.sizes``), the bot's EOD rate and whether it is frozen.
 A lone agent is agent 0 whatever its role, so the alone conditions are
 matched by role too, and each is matched to the size class whose role has its
 size (:func:`matched_alone`: B alone at 0.75 is the control of B in A<B).
-Size classes take ``style.ONEPATCH_CLASS_COLOURS``, an alone control a light
-tint of its class; in the bot assay the bot plays A (it sits at the patch), so
+Size classes (and their labels) follow the recorded sizes of A and B and take
+``style.ONEPATCH_CLASS_COLOURS``, an alone control a light tint of the class it is
+matched to; in the bot assay the bot plays A (it sits at the patch), so
 "bot < B" has the colour of "A < B".
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 
 import numpy as np
 import pandas as pd
 
-from ..config import EfishConfig
+from .. import layout
+from ..config.schema import EfishConfig
 from .panel import Panel
 from .style import (
     NEUTRAL_COLOUR,
@@ -32,20 +35,27 @@ from .style import (
     finite,
     missing,
     stars_for,
+    tint,
 )
 
 Tables = dict[str, pd.DataFrame]
+#: Condition -> its recorded config, in the assay's order (:func:`~efish.figures.style.assay_conditions`).
+Configs = Mapping[str, EfishConfig]
+ONEPATCH, BOT, PAIRS = "onepatch", "bot", "square2"
 
 #: The one-patch roles (``env.roles``) and the letter each has in the paper.
 ROLE_LETTERS = {"resident": "A", "intruder": "B"}
 _ROLE_NAMES = {letter: role for role, letter in ROLE_LETTERS.items()}
-#: Short labels of the one-patch conditions (config/assay/onepatch.yaml); an unknown name is shown as is.
-#: An alone control is labelled with the lone agent's size (on tick labels the size goes on a second line).
+#: Short labels of the one-patch conditions (config/assay/onepatch.yaml) where no recorded config says more
+#: (captions); an unknown name is shown as is. On a panel, :func:`class_label` reads the label off the recorded
+#: config. An alone control is labelled with the lone agent's size (on tick labels the size goes on a second line).
 CLASS_LABELS = {"A_lt_B": "A<B", "A_eq_B": "A=B", "A_gt_B": "A>B",
                 "A_alone_25": "A alone, 0.25", "A_alone_50": "A alone, 0.5", "A_alone_75": "A alone, 0.75",
                 "B_alone_25": "B alone, 0.25", "B_alone_50": "B alone, 0.5", "B_alone_75": "B alone, 0.75"}
+#: Size of A against size of B -> the one-patch size class (its colour in ONEPATCH_CLASS_COLOURS).
+SIZE_CLASSES = {"<": "A_lt_B", "=": "A_eq_B", ">": "A_gt_B"}
 #: Bot size relation -> the one-patch class whose colour it takes (the bot plays the resident A).
-BOT_CLASSES = {"<": "A_lt_B", "=": "A_eq_B", ">": "A_gt_B"}
+BOT_CLASSES = SIZE_CLASSES
 #: Most bouts whose chaser and chased (or biter and bitten) are joined by a line in panels L and N.
 MAX_PAIR_LINES = 200
 TRAJECTORY_CONDITIONS = ("A_lt_B", "A_eq_B", "A_gt_B")
@@ -54,16 +64,17 @@ DARK_GREY = "#404040"
 
 
 # ------------------------------------------------------------------ configs
-def onepatch_roles() -> dict[str, dict[str, int]]:
-    """Per one-patch condition: role letter ("A", "B") -> agent index, from each condition's ``env.roles``."""
+def onepatch_roles(configs: Configs) -> dict[str, dict[str, int]]:
+    """Per one-patch condition: role letter ("A", "B") -> agent index, from each condition's ``env.roles``
+    (``configs``: the one-patch conditions the run recorded)."""
     return {cond: {ROLE_LETTERS[r]: i for i, r in enumerate(cfg.env.roles) if r in ROLE_LETTERS}
-            for cond, cfg in assay_conditions("onepatch").items()}
+            for cond, cfg in configs.items()}
 
 
-def matched_alone() -> dict[tuple[str, str], str]:
+def matched_alone(configs: Configs) -> dict[tuple[str, str], str]:
     """(role letter, social condition) -> the one-patch alone condition whose lone agent has that role and the size
-    the role has in the social condition (from each condition's ``env.roles`` and ``env.sizes``)."""
-    configs, roles = assay_conditions("onepatch"), onepatch_roles()
+    the role has in the social condition (from each recorded condition's ``env.roles`` and ``env.sizes``)."""
+    roles = onepatch_roles(configs)
     alone = {cond: (letter, configs[cond].env.sizes) for cond, r in roles.items() if len(r) == 1 for letter in r}
     out = {}
     for cond, r in roles.items():
@@ -77,25 +88,26 @@ def matched_alone() -> dict[tuple[str, str], str]:
     return out
 
 
-def role_rows(table: pd.DataFrame, role: str) -> pd.DataFrame:
+def role_rows(table: pd.DataFrame, role: str, configs: Configs) -> pd.DataFrame:
     """The rows of ``table`` (with condition and agent columns) that belong to ``role`` ("A" or "B").
 
     Conditions without that role (e.g. "A alone" for B) are dropped; the
-    ``condition`` column becomes an ordered categorical in config order.
+    ``condition`` column becomes an ordered categorical in the assay's order.
     """
     if role not in ROLE_LETTERS.values():
         raise ValueError(f"role must be one of {sorted(ROLE_LETTERS.values())}, got {role!r}")
-    agents = {cond: roles[role] for cond, roles in onepatch_roles().items() if role in roles}
+    agents = {cond: roles[role] for cond, roles in onepatch_roles(configs).items() if role in roles}
     mine = table["agent"].to_numpy() == table["condition"].map(agents).to_numpy()
     out = table[mine].copy()
     out["condition"] = pd.Categorical(out["condition"], categories=list(agents), ordered=True)
     return out
 
 
-def bot_conditions() -> pd.DataFrame:
-    """One row per bot condition: the trained agent, the size class (bot vs B), bot EOD rate, frozen or moving."""
+def bot_conditions(configs: Configs) -> pd.DataFrame:
+    """One row per bot condition (``configs``: the bot assay's recorded conditions): the trained agent, the size
+    class (bot vs B), bot EOD rate, frozen or moving."""
     rows = []
-    for cond, cfg in assay_conditions("bot").items():
+    for cond, cfg in configs.items():
         bot = cfg.env.bots[0]
         agent = next(i for i in range(cfg.env.n_agents) if i not in cfg.env.bots)
         s_bot, s_agent = cfg.env.sizes[bot], cfg.env.sizes[agent]
@@ -118,7 +130,45 @@ def _usable(ax, table: pd.DataFrame, column: str, what: str) -> pd.DataFrame | N
 
 
 def _class_label(cond: str) -> str:
+    """The label of a condition by its name alone (captions, written before any run)."""
     return CLASS_LABELS.get(cond, cond)
+
+
+def size_class(cond: str, configs: Configs) -> str | None:
+    """The size class (a key of :data:`SIZE_CLASSES`' values) of one-patch condition ``cond`` as the run recorded it:
+    A's size against B's; None for a condition without both roles or without fixed sizes."""
+    cfg = configs.get(cond)
+    roles = onepatch_roles({cond: cfg})[cond] if cfg is not None else {}
+    if len(roles) < 2 or not cfg.env.sizes:
+        return None
+    a, b = cfg.env.sizes[roles["A"]], cfg.env.sizes[roles["B"]]
+    return SIZE_CLASSES["=" if np.isclose(a, b) else "<" if a < b else ">"]
+
+
+def class_label(cond: str, configs: Configs) -> str:
+    """Label of a one-patch condition from its recorded config: a social one ``A<B``, ``A=B`` or ``A>B`` (its
+    :func:`size_class`), an alone control ``<role> alone, <size>``; anything else :func:`_class_label`."""
+    if (key := size_class(cond, configs)) is not None:
+        return CLASS_LABELS[key]
+    cfg = configs.get(cond)
+    roles = onepatch_roles({cond: cfg})[cond] if cfg is not None else {}
+    if len(roles) == 1 and len(cfg.env.sizes) == 1:
+        return f"{next(iter(roles))} alone, {float(cfg.env.sizes[0]):g}"
+    return _class_label(cond)
+
+
+def class_colours(role: str, conditions, configs: Configs) -> dict:
+    """Colour per one-patch condition on the panels of ``role``: a social condition its recorded size class's
+    colour, an alone control a light tint of the class it is matched to for ``role`` (:func:`matched_alone`);
+    others their ONEPATCH_CLASS_COLOURS entry, else grey (empty slots)."""
+    matched = {alone: social for (r, social), alone in matched_alone(configs).items() if r == role}
+    out = {}
+    for cond in conditions:
+        key = size_class(cond, configs)
+        base = size_class(matched[cond], configs) if key is None and cond in matched else None
+        out[cond] = (ONEPATCH_CLASS_COLOURS[key] if key else tint(ONEPATCH_CLASS_COLOURS[base]) if base
+                     else ONEPATCH_CLASS_COLOURS.get(cond, NEUTRAL_COLOUR))
+    return out
 
 
 def _class_legend(ax, keys: list, labels: list, title: str | None = None) -> None:
@@ -155,14 +205,14 @@ def assay_scene(tables: Tables, ax) -> None:
     """Panel A: the one-patch arena at the first step of the first A<B episode: A at the patch, B facing it,
     the pellets at the start (inset), and B's start position in every social episode (grey)."""
     steps, food = tables["steps"], tables["food"]
-    cfg = assay_conditions("onepatch")
-    roles = onepatch_roles()
+    cfg = assay_conditions(tables, ONEPATCH)
+    roles = onepatch_roles(cfg)
     social = [c for c, r in roles.items() if len(r) == 2 and c in set(steps["condition"])]
     if not social:
         missing(ax, "no social one-patch condition in the steps table")
         return
     first = steps[steps["t"] == steps.groupby(["condition", "episode"])["t"].transform("min")]
-    starts = role_rows(first[first["condition"].isin(social)], "B")
+    starts = role_rows(first[first["condition"].isin(social)], "B", cfg)
     _arena(ax, cfg[social[0]])
     ax.scatter(starts["x_cm"], starts["y_cm"], s=4, color=NEUTRAL_COLOUR, alpha=0.6, edgecolors="none",
                label=f"B starts ({len(starts)} episodes)")
@@ -194,7 +244,7 @@ def assay_scene(tables: Tables, ax) -> None:
     inset.set_title(f"{len(pellets)} pellets at t=0", fontsize=6, pad=2)
     ax.indicate_inset_zoom(inset, edgecolor=NEUTRAL_COLOUR, lw=0.5)
     ax.legend(loc=f"{'upper' if top else 'lower'} {'left' if right else 'right'}", fontsize=6, markerscale=2)
-    ax.set_title(f"One-patch assay ({_class_label(social[0])}, episode {episode})")
+    ax.set_title(f"One-patch assay ({class_label(social[0], cfg)}, episode {episode})")
 
 
 def _body(ax, body: pd.Series, colour, text: str | None, arrow_cm: float, label_offset=(8, -10)) -> None:
@@ -218,8 +268,9 @@ def trajectory_panel(condition: str) -> Callable[[Tables, object], None]:
         if run.empty:
             missing(ax, f"no {condition} episode in the onepatch steps table")
             return
-        _arena(ax, assay_conditions("onepatch")[condition])
-        for role, agent in onepatch_roles()[condition].items():
+        configs = assay_conditions(tables, ONEPATCH)
+        _arena(ax, configs[condition])
+        for role, agent in onepatch_roles(configs)[condition].items():
             path = run[run["agent"] == agent].sort_values("t")
             if path.empty:
                 continue
@@ -231,21 +282,21 @@ def trajectory_panel(condition: str) -> Callable[[Tables, object], None]:
             ax.plot(ate["x_cm"], ate["y_cm"], "*", color=colour, ms=5, mec="black", mew=0.3, ls="none")
         ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=6, title="o start, * ate", title_fontsize=6,
                   frameon=False)  # beside the arena: the paths cover all of it
-        ax.set_title(f"{_class_label(condition)}, episode {int(run['episode'].iloc[0])}")
+        ax.set_title(f"{class_label(condition, configs)}, episode {int(run['episode'].iloc[0])}")
 
     draw.__doc__ = f"Panel: paths of A and B in the first {condition} episode of the one-patch assay."
     return draw
 
 
 # ---------------------------------------------------------- E,F: food per role
-def class_slots(role: str, present) -> list[str]:
+def class_slots(role: str, present, configs: Configs) -> list[str]:
     """The x slots of panels E-H for ``role``: each size class of the config present, then its size-matched alone
     control (if present), an empty slot between classes; alone conditions matched to no class last. An empty slot
     is a blank name, one space more for each (seaborn needs distinct categories)."""
-    present = set(present)
-    matched = matched_alone()
-    socials = [c for c, r in onepatch_roles().items() if len(r) == 2 and c in present]
-    rest = [c for c, r in onepatch_roles().items() if role in r and c in present and c not in socials
+    present, roles = set(present), onepatch_roles(configs)
+    matched = matched_alone(configs)
+    socials = [c for c, r in roles.items() if len(r) == 2 and c in present]
+    rest = [c for c, r in roles.items() if role in r and c in present and c not in socials
             and c not in (matched.get((role, s)) for s in socials)]
     groups = [[c, *([matched[role, c]] if matched.get((role, c)) in present else [])] for c in socials]
     slots: list[str] = []
@@ -254,8 +305,8 @@ def class_slots(role: str, present) -> list[str]:
     return slots
 
 
-def _tick_label(cond: str) -> str:
-    return _class_label(cond).replace(", ", "\n") if cond.strip() else ""
+def _tick_label(cond: str, configs: Configs) -> str:
+    return class_label(cond, configs).replace(", ", "\n") if cond.strip() else ""
 
 
 def food_by_role(role: str) -> Callable[[Tables, object], None]:
@@ -266,22 +317,23 @@ def food_by_role(role: str) -> Callable[[Tables, object], None]:
         food = _usable(ax, tables["food"], "food_eaten", "onepatch food_per_agent")
         if food is None:
             return
-        rows = role_rows(food, role)
-        order = class_slots(role, rows["condition"].astype(str))
+        configs = assay_conditions(tables, ONEPATCH)
+        rows = role_rows(food, role, configs)
+        order = class_slots(role, rows["condition"].astype(str), configs)
         if not order:
             missing(ax, f"no agent of role {role} in the onepatch food table")
             return
         data = rows.assign(condition=rows["condition"].astype(str))
-        palette = {c: ONEPATCH_CLASS_COLOURS.get(c, NEUTRAL_COLOUR) for c in order}
+        palette = class_colours(role, order, configs)
         if not box_strip(ax, data, "condition", "food_eaten", order, palette,
-                         labels={c: _tick_label(c) for c in order}):
+                         labels={c: _tick_label(c, configs) for c in order}):
             return
         tests = tables["tests"]
         tests = tests[tests["role"] == role] if "role" in tests.columns else tests.iloc[:0]
         values = finite(data["food_eaten"])
         lo, hi = float(values.min()), float(values.max())
         pad = (hi - lo) * 0.06 or max(abs(hi), 1.0) * 0.06
-        matched = matched_alone()
+        matched = matched_alone(configs)
         for i, cond in enumerate(order):
             alone = matched.get((role, cond))
             if alone is None or i + 1 >= len(order) or order[i + 1] != alone:
@@ -307,18 +359,22 @@ def food_course_by_role(role: str) -> Callable[[Tables, object], None]:
         course = _usable(ax, tables["course"], "mean_food", "onepatch food_time_course")
         if course is None:
             return
-        rows = role_rows(course, role)
-        fps = next(iter(assay_conditions("onepatch").values())).env.fps
-        matched = matched_alone()
+        configs = assay_conditions(tables, ONEPATCH)
+        rows = role_rows(course, role, configs)
+        matched = matched_alone(configs)
         alone = {a for (r, _), a in matched.items() if r == role}
-        for cond in (c for c in class_slots(role, rows["condition"].astype(str)) if c.strip()):
+        slots = [c for c in class_slots(role, rows["condition"].astype(str), configs) if c.strip()]
+        colours = class_colours(role, slots, configs)
+        yellow = ONEPATCH_CLASS_COLOURS["A_gt_B"]
+        for cond in slots:
             c = rows[rows["condition"] == cond].sort_values("t")
-            colour = ONEPATCH_CLASS_COLOURS.get(cond, NEUTRAL_COLOUR)
-            t, mean, sem = c["t"] / fps, c["mean_food"], c["sem_food"].fillna(0)
+            colour = colours[cond]
+            # steps to seconds at the frame rate the run simulated this condition at
+            t, mean, sem = c["t"] / configs[cond].env.fps, c["mean_food"], c["sem_food"].fillna(0)
             ax.fill_between(t, mean - sem, mean + sem, color=colour, alpha=0.25, lw=0)
-            light = cond in ("A_gt_B", matched.get((role, "A_gt_B")))  # the faint yellow class and its control
-            ax.plot(t, mean, color=colour, lw=1.0, ls="--" if cond in alone else "-", label=_class_label(cond),
-                    path_effects=_outline() if light else None)
+            light = colour in (yellow, tint(yellow))  # the faint yellow class and its control
+            ax.plot(t, mean, color=colour, lw=1.0, ls="--" if cond in alone else "-",
+                    label=class_label(cond, configs), path_effects=_outline() if light else None)
         ax.set_xlabel("time (s)")
         ax.set_ylabel(f"cumulative food of {role} (pellets)")
         ax.set_title(f"Food of {role} over time")
@@ -348,7 +404,7 @@ def bot_reach(contrast: str) -> Callable[[Tables, object], None]:
         rates = _usable(ax, tables["reach"], "reach_rate", "bot reach_rates")
         if rates is None:
             return
-        rows = rates.merge(bot_conditions(), on=["condition", "agent"])  # only the trained agent B
+        rows = rates.merge(bot_conditions(assay_conditions(tables, BOT)), on=["condition", "agent"])  # B only
         if rows.empty:
             missing(ax, "no reach rate of the trained agent in the bot table")
             return
@@ -498,20 +554,24 @@ def bite_rate(tables: Tables, ax) -> None:
 
 
 # --------------------------------------------------------------------- panels
-_ONEPATCH = "assays/onepatch"
-_FOOD = "analysis/behaviour/onepatch/food_per_agent.parquet"
-_COURSE = "analysis/onepatch/onepatch/food_time_course.parquet"
-_REACH = "analysis/onepatch/bot/reach_rates.parquet"
-_PAIRS = "analysis/interactions/square2"
-_ROLE_TESTS = "analysis/onepatch/onepatch/role_tests.parquet"
-_REACH_TESTS = "analysis/onepatch/bot/reach_tests.parquet"
+_STEPS, _PELLETS = layout.assay_table(ONEPATCH, "steps"), layout.assay_table(ONEPATCH, "food")
+_FOOD = layout.analysis_table("behaviour", ONEPATCH, "food_per_agent")
+_COURSE = layout.analysis_table("onepatch", ONEPATCH, "food_time_course")
+_REACH = layout.analysis_table("onepatch", BOT, "reach_rates")
+_ROLE_TESTS = layout.analysis_table("onepatch", ONEPATCH, "role_tests")
+_REACH_TESTS = layout.analysis_table("onepatch", BOT, "reach_tests")
+
+
+def _pairs(table: str) -> str:
+    return layout.analysis_table("interactions", PAIRS, table)
+
 
 PANELS: list[Panel] = [
     Panel("fig5", "A", assay_scene,
-          {"steps": f"{_ONEPATCH}/steps.parquet", "food": f"{_ONEPATCH}/food.parquet"},
+          {"steps": _STEPS, "food": _PELLETS},
           "One-patch assay scene (onepatch steps at t=0 and food table): resident A at the central patch, "
           "intruder B facing it, pellets at the start (inset), grey: B's start in every social episode."),
-    *[Panel("fig5", letter, trajectory_panel(cond), {"steps": f"{_ONEPATCH}/steps.parquet"},
+    *[Panel("fig5", letter, trajectory_panel(cond), {"steps": _STEPS},
             f"Paths of A and B in the first {_class_label(cond)} episode of the onepatch assay (steps table); "
             "o marks the start, * each pellet eaten; dashed circle: the patch.")
       for letter, cond in zip("BCD", TRAJECTORY_CONDITIONS, strict=True)],
@@ -540,25 +600,25 @@ PANELS: list[Panel] = [
           "0.25-1), per size pair; each point one bot condition (bot assay, onepatch reach_rates). Stars: Fisher "
           "exact test of B's pooled reach counts, emitting vs silent (onepatch reach_tests, contrast eod)."),
     Panel("fig5", "K", size_difference("chase"),
-          {"events": f"{_PAIRS}/chase_sizes.parquet", "tests": f"{_PAIRS}/size_tests.parquet"},
+          {"events": _pairs("chase_sizes"), "tests": _pairs("size_tests")},
           "Chaser minus chased body size per chasing bout (square2, interactions chase_sizes), with the median "
           "paired difference and Wilcoxon signed-rank stars (interactions size_tests, measure chase)."),
     Panel("fig5", "L", role_sizes("chase"),
-          {"events": f"{_PAIRS}/chase_sizes.parquet", "tests": f"{_PAIRS}/size_tests.parquet"},
+          {"events": _pairs("chase_sizes"), "tests": _pairs("size_tests")},
           "Sizes of chaser and chased per chasing bout, pairs joined (square2, interactions chase_sizes); stars: "
           "Wilcoxon signed-rank chaser vs chased (interactions size_tests)."),
     Panel("fig5", "M", size_difference("bite"),
-          {"events": f"{_PAIRS}/bite_sizes.parquet", "tests": f"{_PAIRS}/size_tests.parquet"},
+          {"events": _pairs("bite_sizes"), "tests": _pairs("size_tests")},
           "Biter minus bitten body size per bite (square2, interactions bite_sizes), with the median paired "
           "difference and Wilcoxon signed-rank stars (interactions size_tests, measure bite)."),
     Panel("fig5", "N", role_sizes("bite"),
-          {"events": f"{_PAIRS}/bite_sizes.parquet", "tests": f"{_PAIRS}/size_tests.parquet"},
+          {"events": _pairs("bite_sizes"), "tests": _pairs("size_tests")},
           "Sizes of biter and bitten per bite, pairs joined (square2, interactions bite_sizes); stars: Wilcoxon "
           "signed-rank biter vs bitten (interactions size_tests)."),
-    Panel("fig5", "O", bite_timing, {"timing": f"{_PAIRS}/bite_timing.parquet"},
+    Panel("fig5", "O", bite_timing, {"timing": _pairs("bite_timing")},
           "Phase within its bout of every bite inside a bout, stacked by bout class (square2, interactions "
           "bite_timing)."),
-    Panel("fig5", "P", bite_rate, {"rate": f"{_PAIRS}/bite_rate_by_class.parquet"},
+    Panel("fig5", "P", bite_rate, {"rate": _pairs("bite_rate_by_class")},
           "Bites per ordered pair-step within bout range, by the biter's per-step interaction label (square2, "
           "interactions bite_rate_by_class)."),
 ]

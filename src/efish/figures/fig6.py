@@ -18,6 +18,7 @@ import re
 import numpy as np
 import pandas as pd
 
+from .. import layout
 from ..config.schema import AnalysisConfig
 from .panel import Panel, Tables
 from .style import (
@@ -25,6 +26,7 @@ from .style import (
     NEUTRAL_COLOUR,
     RECEPTOR_COLOURS,
     annotate_stars,
+    assay_conditions,
     box_strip,
     condition_order,
     condition_palette,
@@ -59,10 +61,16 @@ READOUT_HATCH = "////"
 POWER_LABEL = "wideband power (1/Hz)"
 
 
+def analysis_config(tables: Tables, assay: str) -> AnalysisConfig:
+    """The analysis settings (``cfg.analysis``) the run recorded with ``assay``'s conditions (its control's):
+    thresholds named on a panel follow the run's overrides, not the schema's defaults."""
+    return next(iter(assay_conditions(tables, assay).values())).analysis
+
+
 def dimensionality_box(tables: Tables, ax) -> None:
     """Panel A: D_eff and the number of PCs reaching the variance fraction, per agent-episode of patchy4."""
     dims = tables["dims"]
-    share = AnalysisConfig().variance_fraction
+    share = analysis_config(tables, "patchy4").variance_fraction
     names = {"d_eff": "D_eff", "pcs_for_variance": f"PCs for {share:.0%} var."}
     long = dims.melt(id_vars=[c for c in dims.columns if c not in names], value_vars=list(names),
                      var_name="measure", value_name="dimensions")
@@ -155,7 +163,7 @@ def decoding_bars(assay: str, title: str, control: str | None = None):
             return rows.groupby("label")["score"].mean().sort_values(ascending=False).index.tolist()
 
         sensed, readouts = ranked(scored[~readout]), ranked(scored[readout])
-        conditions = condition_order(assay, scored["condition"], control)
+        conditions = condition_order(tables, assay, scored["condition"], control)
         sns.barplot(data=scored, x="score", y="label", hue="condition", order=sensed + readouts,
                     hue_order=conditions, palette=condition_palette(conditions, control), orient="h",
                     legend=len(conditions) > 1, ax=ax)
@@ -192,7 +200,7 @@ def food_decoding_bars(tables: Tables, ax) -> None:
     sns.barplot(data=scored, x="score", y="label", hue="food", hue_order=ranges, palette=FOOD_RANGE_COLOURS,
                 orient="h", errorbar=None, ax=ax)
     ax.axvline(0.0, color="black", lw=0.5)
-    near = AnalysisConfig().claims_food_near_cm
+    near = analysis_config(tables, "wide2").claims_food_near_cm
     ax.legend(title=f"food (near: <= {near:g} cm)", fontsize=6, title_fontsize=6, loc="best")
     ax.set_xlabel("decoding score (R$^2$ - baseline R$^2$)")
     ax.set_ylabel("decoded variable")
@@ -215,7 +223,7 @@ def plsc_bars(column: str, ylabel: str, title: str, integer: bool = False):
         if "lo_cm" not in plsc or plsc["lo_cm"].isna().all():
             missing(ax, f"plsc table has no distance bins: {plsc['reason'].iloc[0] if len(plsc) else 'empty'}")
             return
-        conditions = condition_order("wide2", plsc["condition"].dropna())
+        conditions = condition_order(tables, "wide2", plsc["condition"].dropna())
         palette = condition_palette(conditions)
         bins = plsc[["lo_cm", "hi_cm"]].drop_duplicates().sort_values("lo_cm").to_numpy()
         width = 0.8 / len(conditions)
@@ -275,7 +283,7 @@ def power_near_far(tables: Tables, ax) -> None:
     wide = wide.reindex(columns=order).dropna()
     ax.plot([0, 1], wide.to_numpy(float).T, color=NEUTRAL_COLOUR, lw=0.3, alpha=0.5, zorder=1)
     _pair_bracket(ax, frame, "wideband_power", tables["tests"], "near_far")
-    a = AnalysisConfig()
+    a = analysis_config(tables, "wide2")
     ax.set_xticks([0, 1], [f"near (<= {a.claims_near_cm:g} cm)", f"far (> {a.claims_far_cm:g} cm)"])
     ax.set_xlabel("nearest conspecific (wide2)")
     ax.set_ylabel(label)
@@ -298,7 +306,7 @@ def power_by_size(tables: Tables, ax) -> None:
 
 
 def _dyn(assay: str, table: str) -> str:
-    return f"analysis/dynamics/{assay}/{table}.parquet"
+    return layout.analysis_table("dynamics", assay, table)
 
 
 PANELS = [
@@ -350,7 +358,7 @@ PANELS = [
           "claims_near_cm vs beyond analysis.claims_far_cm, pairs joined (dynamics power_near_far); stars: Wilcoxon "
           "signed-rank far vs near over agent-episodes (dynamics power_tests, measure near_far)."),
     Panel("fig6", "J", power_by_size, {"dims": _dyn("wide2", "dimensionality"),
-                                       "episodes": "assays/wide2/episodes.parquet",
+                                       "episodes": layout.assay_table("wide2", "episodes"),
                                        "tests": _dyn("wide2", "power_tests")},
           "Wideband power of the hidden state per agent-episode of the wide2 assay, the smallest agent of each "
           "episode vs the others (sizes from the episodes table; episodes of equal sizes left out), "

@@ -3,8 +3,11 @@
 Each figure module (``fig1`` ... ``fig6``, ``supplement``) ends with a list
 ``PANELS`` of these; :mod:`efish.figures.registry` gathers them. A panel
 draws on one matplotlib axes (``projection`` picks e.g. a polar one) from a
-dict of tables keyed like its ``inputs``; a schematic panel reads nothing
-(``inputs={}``).
+dict of tables keyed like its :attr:`Panel.tables`: its ``inputs`` and, for
+every assay it reads, that assay's ``conditions.parquet`` under
+``conditions/<assay>`` (what each condition resolved to in the run: roles,
+sizes, arena, fps), so that a panel draws what the run simulated and never
+composes a config of its own. A schematic panel reads nothing (``inputs={}``).
 """
 
 from __future__ import annotations
@@ -14,14 +17,23 @@ from dataclasses import dataclass, field
 
 import pandas as pd
 
+from .. import layout
+
 Tables = dict[str, pd.DataFrame]
+
+
+def conditions_key(assay: str) -> str:
+    """The key under which a panel's tables hold the conditions table of ``assay``: ``conditions/<assay>``."""
+    return f"conditions/{assay}"
 
 
 @dataclass(frozen=True)
 class Panel:
-    """One panel. ``inputs`` maps a table name to a path relative to ``results/{run}``; a path with ``{seed}``
-    stands for every trained seed (concatenated with a ``seed`` column). ``caption`` says what the panel
-    shows, from which assay, table and statistic (it is the report's caption)."""
+    """One panel. ``inputs`` maps a table name to a path relative to ``results/{run}`` (built with
+    :mod:`efish.layout`); a path with ``{seed}`` stands for every trained seed (concatenated with a ``seed``
+    column). A panel that needs an assay's conditions without reading another table of it names
+    ``conditions/<assay>`` in ``inputs`` itself. ``caption`` says what the panel shows, from which assay, table
+    and statistic (it is the report's caption)."""
 
     figure: str
     name: str
@@ -34,17 +46,23 @@ class Panel:
     def key(self) -> str:
         return f"{self.figure}/{self.name}"
 
+    def _parsed(self, kind: str) -> set[str]:
+        return {t.assay for path in self.inputs.values() if (t := layout.parse_table(path)) and t.kind == kind}
+
     def assays(self) -> set[str]:
         """Assays whose tables this panel reads (rollout or analysis tables)."""
-        names = set()
-        for path in self.inputs.values():
-            parts = path.split("/")
-            if parts[0] == "assays":
-                names.add(parts[1])
-            elif parts[0] == "analysis" and len(parts) > 3:  # analysis/<analysis>/<assay>/<table>.parquet
-                names.add(parts[2])
-        return names
+        return self._parsed("assays") | self._parsed("analysis")
 
     def top_seed_assays(self) -> set[str]:
         """Assays of the top-ranked seeds whose stacked tables this panel reads (``seeds/<assay>/...``)."""
-        return {path.split("/")[1] for path in self.inputs.values() if path.startswith("seeds/")}
+        return self._parsed("seeds")
+
+    @property
+    def conditions(self) -> dict[str, str]:
+        """The conditions table of every assay this panel reads: ``conditions/<assay>`` -> its path."""
+        return {conditions_key(assay): layout.assay_table(assay, "conditions") for assay in sorted(self.assays())}
+
+    @property
+    def tables(self) -> dict[str, str]:
+        """Every table the panel reads, name -> relative path: its ``inputs``, then :attr:`conditions`."""
+        return {**self.inputs, **self.conditions}

@@ -16,23 +16,31 @@ PANEL_SIZE_IN = (3.5, 2.8)
 
 
 def input_paths(panel: Panel, results: Path, seeds: int) -> dict[str, list[Path]]:
-    """Every file a panel reads: ``{seed}`` expands over seeds 1..seeds."""
+    """Every file a panel reads (:attr:`Panel.tables`: its inputs and the conditions of its assays): ``{seed}``
+    expands over seeds 1..seeds."""
     return {name: [results / path.format(seed=s) for s in range(1, seeds + 1)] if "{seed}" in path
-            else [results / path] for name, path in panel.inputs.items()}
+            else [results / path] for name, path in panel.tables.items()}
+
+
+def check_inputs(panel: Panel, results: Path, seeds: int) -> None:
+    """One clear error naming the first table of ``panel`` that does not exist (a missing conditions table: rerun
+    the assay, which writes it)."""
+    for name, paths in input_paths(panel, results, seeds).items():
+        for path in paths:
+            if not path.is_file():
+                hint = "rerun the assay, which records its conditions" if name in panel.conditions else \
+                    "run the pipeline first"
+                raise ValueError(f"panel {panel.key} needs {path}, which does not exist ({hint})")
 
 
 def load_tables(panel: Panel, results: Path, seeds: int) -> dict[str, pd.DataFrame]:
-    """The panel's tables; a per-seed path gets a ``seed`` column. A missing file is one clear error."""
-    tables = {}
-    for name, paths in input_paths(panel, results, seeds).items():
-        frames = []
-        for seed, path in enumerate(paths, 1):
-            if not path.is_file():
-                raise ValueError(f"panel {panel.key} needs {path}, which does not exist (run the pipeline first)")
-            frame = read_parquet(path)
-            frames.append(frame.assign(seed=seed) if "{seed}" in panel.inputs[name] else frame)
-        tables[name] = pd.concat(frames, ignore_index=True)
-    return tables
+    """The panel's tables (:attr:`Panel.tables`); a per-seed path gets a ``seed`` column. A missing file is one
+    clear error (:func:`check_inputs`)."""
+    check_inputs(panel, results, seeds)
+    declared = panel.tables
+    return {name: pd.concat([read_parquet(path).assign(seed=seed) if "{seed}" in declared[name] else read_parquet(path)
+                             for seed, path in enumerate(paths, 1)], ignore_index=True)
+            for name, paths in input_paths(panel, results, seeds).items()}
 
 
 def render_panel(key: str, results: Path, out: Path, seeds: int) -> list[Path]:
@@ -53,21 +61,31 @@ def draw_panel(panel: Panel, tables: dict[str, pd.DataFrame], plt):
     return fig
 
 
-def render_page(figure: str, panels: list[Panel], results: Path, out: Path, seeds: int) -> list[Path]:
-    """All ``panels`` of one figure on one page, lettered by their ids: ``out/<figure>.png`` and ``.pdf``."""
+def render_figure(figure: str, panels: list[Panel], results: Path, out: Path, seeds: int) -> dict[str, list[Path]]:
+    """Every panel of ``figure`` (``out/<figure>/<panel>.png`` and ``.pdf``) and its page (``out/<figure>.png``
+    and ``.pdf``, the panels lettered by their ids), each panel's tables read once for both drawings and let go
+    before the next panel's (a paper-scale steps table is large). Every input is checked to exist before anything
+    is drawn, so a missing table writes nothing. Returns panel key (and ``figure`` for the page) -> files."""
     if not panels:
         raise ValueError(f"figure {figure!r} has no panels to draw at this scale")
+    for panel in panels:
+        check_inputs(panel, results, seeds)
+    written = {}
     cols = min(3, len(panels))
     rows = math.ceil(len(panels) / cols)
     with panel_style() as plt:
-        fig = plt.figure(figsize=(PANEL_SIZE_IN[0] * cols, PANEL_SIZE_IN[1] * rows), layout="constrained")
+        page = plt.figure(figsize=(PANEL_SIZE_IN[0] * cols, PANEL_SIZE_IN[1] * rows), layout="constrained")
         for i, panel in enumerate(panels, 1):
-            ax = fig.add_subplot(rows, cols, i, projection=panel.projection)
-            panel.draw(load_tables(panel, results, seeds), ax)
+            tables = load_tables(panel, results, seeds)
+            fig = draw_panel(panel, tables, plt)
+            written[panel.key] = save_figure(fig, out / panel.figure / panel.name)
+            plt.close(fig)
+            ax = page.add_subplot(rows, cols, i, projection=panel.projection)
+            panel.draw(tables, ax)
             ax.text(-0.15, 1.05, panel.name if len(panel.name) == 1 else "", transform=ax.transAxes,
                     fontweight="bold", fontsize=11)
-        written = save_figure(fig, out / figure)
-        plt.close(fig)
+        written[figure] = save_figure(page, out / figure)
+        plt.close(page)
     return written
 
 

@@ -8,12 +8,16 @@ sets a print-size theme (one column = 3.5 in, 7-8 pt text).
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from contextlib import contextmanager
-from functools import lru_cache
 
 import numpy as np
 import pandas as pd
+
+from .. import layout
+from ..config.recorded import recorded_conditions
+from ..config.schema import EfishConfig
+from .panel import conditions_key
 
 AGENT_COLOURS = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#F0E442", "#000000")
 RECEPTOR_COLOURS = {"mormyromast": "#0072B2", "ampullary": "#009E73", "knollenorgan": "#D55E00"}
@@ -235,22 +239,23 @@ PELLET_COLOUR = "#8c564b"
 
 
 # ------------------------------------------- assay conditions: configs and display order
-@lru_cache(maxsize=8)
-def assay_conditions(assay: str) -> dict:
-    """The composed config of every condition of ``config/assay/<assay>.yaml``, in the listed order (the first
-    is the control). Cached: Hydra composes once per assay; panels of Figs 4-6 read roles, sizes and order here."""
-    from ..config import config_dir
-    from ..config.compose import compose_variants
+def assay_conditions(tables: Mapping[str, pd.DataFrame], assay: str) -> Mapping[str, EfishConfig]:
+    """The config of every condition of ``assay`` as the run resolved it (with every override it had), in the
+    assay's order (the first is the control), from the panel's ``conditions/<assay>`` table
+    (``assays/<assay>/conditions.parquet``, :attr:`efish.figures.panel.Panel.conditions`). Panels of Figs 3-6
+    read roles, sizes, arena, fps and order here; nothing is composed."""
+    key, path = conditions_key(assay), layout.assay_table(assay, "conditions")
+    if key not in tables:
+        raise ValueError(f"the panel's tables hold no {key} ({path}): a panel that reads assay {assay}'s "
+                         f"conditions but no other table of it names {path} in its inputs; an older run lacks "
+                         "the file: rerun the assay")
+    return recorded_conditions(tables[key], path)
 
-    if not (config_dir() / "assay" / f"{assay}.yaml").is_file():
-        raise ValueError(f"no assay config {config_dir() / 'assay' / f'{assay}.yaml'} to read the conditions of "
-                         f"{assay!r}")
-    return compose_variants([f"assay={assay}"], None, "condition")
 
-
-def condition_order(assay: str, present, control=None) -> list:
-    """Conditions present in a table: ``control`` first, then the assay config's order, then any others sorted."""
+def condition_order(tables: Mapping[str, pd.DataFrame], assay: str, present, control=None) -> list:
+    """Conditions present in a table: ``control`` first, then the assay's recorded order, then any others
+    sorted."""
     present = list(dict.fromkeys(present))
-    listed = [c for c in assay_conditions(assay) if c in present]
+    listed = [c for c in assay_conditions(tables, assay) if c in present]
     order = listed + sorted((c for c in present if c not in listed), key=str)
     return [control, *(c for c in order if c != control)] if control in present else order

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from .. import layout
 from ..analysis.selection import ols_fit
 from .panel import Panel
 from .style import AGENT_COLOURS, NEUTRAL_COLOUR, SELECTED_COLOUR, missing
@@ -195,7 +196,8 @@ def top_seeds_bites(tables: dict[str, pd.DataFrame], ax) -> None:
     ax.set_title("Top seeds: biting vs size")
 
 
-METRICS = {"metrics": "train/seed_{seed}/metrics.parquet", "ranking": "analysis/selection/ranking.parquet"}
+#: ``{seed}`` stands for every trained seed (:func:`efish.figures.render.input_paths` expands it).
+METRICS = {"metrics": layout.training_file(layout.seed_name("{seed}"), "metrics.parquet"), "ranking": layout.RANKING}
 
 PANELS = [
     Panel("supp", "training_curves", training_curves, METRICS,
@@ -209,17 +211,17 @@ PANELS = [
     Panel("supp", "reward_components", reward_components, METRICS,
           "Food reward and bitten penalty, mean per agent-step of each rollout, every seed, 5-point EMA "
           "(train metrics tables)."),
-    Panel("supp", "seed_landscape", seed_landscape, {"ranking": "analysis/selection/ranking.parquet"},
+    Panel("supp", "seed_landscape", seed_landscape, {"ranking": layout.RANKING},
           "Seed selection (SPEC 10): food per episode against the median size-food slope of each seed's "
           "selection episodes, R^2 as colour; hollow markers are seeds dropped for a non-positive intercept, the "
           "ring marks the selected seed (analysis/selection/ranking table)."),
-    Panel("supp", "top_seeds_food", top_seeds_food, {"episodes": "seeds/patchy4/episodes.parquet"},
+    Panel("supp", "top_seeds_food", top_seeds_food, {"episodes": layout.stacked_seeds_table("patchy4")},
           "The top-ranked seeds in the patchy 4-agent assay: food per agent-episode against size with each "
           "seed's OLS line (seeds/patchy4 episodes table, stacked over the top seeds)."),
-    Panel("supp", "top_seeds_eod", top_seeds_eod, {"episodes": "seeds/wide2/episodes.parquet"},
+    Panel("supp", "top_seeds_eod", top_seeds_eod, {"episodes": layout.stacked_seeds_table("wide2")},
           "The top-ranked seeds in the wide 2-agent assay: EOD probability per agent-episode against size with "
           "each seed's OLS line (seeds/wide2 episodes table)."),
-    Panel("supp", "top_seeds_bites", top_seeds_bites, {"episodes": "seeds/square2/episodes.parquet"},
+    Panel("supp", "top_seeds_bites", top_seeds_bites, {"episodes": layout.stacked_seeds_table("square2")},
           "The top-ranked seeds in the square 2-agent assay: bites given minus received per agent-episode "
           "against size with each seed's OLS line (seeds/square2 episodes table)."),
 ]

@@ -10,11 +10,14 @@ from __future__ import annotations
 
 import numpy as np
 
-EPS0 = 8.854e-12  # F/m, SPEC units; configs carry their own copy
-SOFTENING_M = 1e-5
+from ..config.schema import PhysicsConfig
+
+# The keyword defaults below are PhysicsConfig's (eps0, softening_m): the schema is their one home. Simulation
+# code passes the configured values.
+_DEFAULTS = PhysicsConfig()
 
 
-def coulomb_constant(eps0: float = EPS0) -> float:
+def coulomb_constant(eps0: float = _DEFAULTS.eps0) -> float:
     """k = 1 / (4 pi eps0), in V*m/C."""
     return 1.0 / (4.0 * np.pi * eps0)
 
@@ -37,7 +40,7 @@ def _displacements(points: np.ndarray, positions: np.ndarray, softening: float
 
 
 def monopole_field(points: np.ndarray, positions: np.ndarray, charges: np.ndarray, *,
-                   softening: float = SOFTENING_M, eps0: float = EPS0) -> np.ndarray:
+                   softening: float = _DEFAULTS.softening_m, eps0: float = _DEFAULTS.eps0) -> np.ndarray:
     """Field of point charges, E = sum_k k q_k d / |d|^3, at ``points``.
 
     points (M, 2) m, positions (K, 2) m, charges (K,) C -> (M, 2) V/m, float64.
@@ -57,7 +60,7 @@ def monopole_field(points: np.ndarray, positions: np.ndarray, charges: np.ndarra
 
 
 def dipole_field(points: np.ndarray, positions: np.ndarray, moments: np.ndarray, *,
-                 softening: float = SOFTENING_M, eps0: float = EPS0) -> np.ndarray:
+                 softening: float = _DEFAULTS.softening_m, eps0: float = _DEFAULTS.eps0) -> np.ndarray:
     """Field of point dipoles, E = k (3 (p.d) d / |d|^5 - p / |d|^3), at ``points``.
 
     points (M, 2) m, positions (K, 2) m, moments (K, 2) C*m -> (M, 2) V/m, float64.

@@ -76,6 +76,7 @@ class EffectPlan:
     dtype: str
     tolerance: float
     # sources
+    eps0: float                 # vacuum permittivity, F/m (the reference's closed-form fields)
     k: float                    # 1 / (4 pi eps0), V m / C
     eod_charge: float           # C
     eod_half_separation: float  # m
@@ -201,7 +202,7 @@ def build_plan(cfg: EfishConfig, scene: Scene | None = None, *, tolerance: float
     chi = ph.susceptibility
     return EffectPlan(
         effects=effects, dtype=dtype or ph.dtype, tolerance=tol,
-        k=k, eod_charge=ph.eod_charge_c, eod_half_separation=ph.eod_half_separation_cm * CM,
+        eps0=ph.eps0, k=k, eod_charge=ph.eod_charge_c, eod_half_separation=ph.eod_half_separation_cm * CM,
         agent_dipole=ph.agent_dipole_cm, pellet_dipole=ph.pellet_dipole_cm,
         alpha_agent=(ph.agent_radius_cm * CM) ** 3 * chi / k,
         alpha_pellet=(ph.pellet_radius_cm * CM) ** 3 * chi / k,

@@ -43,7 +43,7 @@ def reference_raw(batch: SnapshotBatch, plan: EffectPlan) -> RawReadings:
 def _reference_env(batch: SnapshotBatch, b: int, plan: EffectPlan, out: RawReadings) -> None:
     n = batch.shape[1]
     w, h = batch.width[b] * CM, batch.height[b] * CM
-    soft = np.sqrt(plan.softening2)
+    soft, eps0 = np.sqrt(plan.softening2), plan.eps0
     idx, scale = plan.image_indices, plan.image_scale
     xy = batch.agent_xy[b] * CM
     heading = batch.agent_heading[b]
@@ -59,7 +59,8 @@ def _reference_env(batch: SnapshotBatch, b: int, plan: EffectPlan, out: RawReadi
         for e in np.flatnonzero(emitting):
             pos, q = eod_monopoles(xy[e], heading[e], plan)
             ipos, _, wq = image_sources(pos, None, w, h, idx, scale)
-            p_ind[:, e] = alpha[:, None] * monopole_field(bodies, ipos, np.tile(q, len(idx)) * wq, softening=soft)
+            e_at = monopole_field(bodies, ipos, np.tile(q, len(idx)) * wq, softening=soft, eps0=eps0)
+            p_ind[:, e] = alpha[:, None] * e_at
             p_ind[e, e] = 0.0                                   # a body is not polarised by its own EOD
 
     # Intrinsic dipoles (SPEC 2.2): agents along body +x, pellets along pellet +y.
@@ -73,7 +74,7 @@ def _reference_env(batch: SnapshotBatch, b: int, plan: EffectPlan, out: RawReadi
             ipos, imom = ipos[len(positions):], imom[len(positions):]
         if len(ipos) == 0:
             return np.zeros(len(points))
-        return _normal_component(dipole_field(points, ipos, imom, softening=soft), normals)
+        return _normal_component(dipole_field(points, ipos, imom, softening=soft, eps0=eps0), normals)
 
     for a in range(n):
         others = np.arange(len(bodies)) != a
@@ -88,7 +89,7 @@ def _reference_env(batch: SnapshotBatch, b: int, plan: EffectPlan, out: RawReadi
             if plan.on("wall_distortion") and emitting[a]:
                 pos, q = eod_monopoles(xy[a], heading[a], plan)
                 ipos, _, wq = image_sources(pos, None, w, h, idx, scale)
-                e = monopole_field(s_pos, ipos[2:], (np.tile(q, len(idx)) * wq)[2:], softening=soft)
+                e = monopole_field(s_pos, ipos[2:], (np.tile(q, len(idx)) * wq)[2:], softening=soft, eps0=eps0)
                 self_part = self_part + _normal_component(e, s_n)
             c = plan.k_cons if (not emitting[a] or plan.g_self == 0) else 1.0
             out.morm_self[b, a], out.morm_cons[b, a] = self_part, cons_part
@@ -103,4 +104,5 @@ def _reference_env(batch: SnapshotBatch, b: int, plan: EffectPlan, out: RawReadi
             for slot, j in enumerate(conspecific_slots(n)[a]):
                 if emitting[j]:
                     pos, q = eod_monopoles(xy[j], heading[j], plan)
-                    out.knollenorgan[b, a, slot] = _normal_component(monopole_field(s_pos, pos, q, softening=soft), s_n)
+                    e = monopole_field(s_pos, pos, q, softening=soft, eps0=eps0)
+                    out.knollenorgan[b, a, slot] = _normal_component(e, s_n)

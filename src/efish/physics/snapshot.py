@@ -12,6 +12,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..config.schema import ArenaConfig
+
+_ARENA = ArenaConfig()  # the default arena size is the schema's (arena.width_cm, height_cm)
+
 
 def _float_array(name: str, value, shape_tail: tuple[int, ...], ndim: int) -> np.ndarray:
     a = np.asarray(value, dtype=np.float64)
@@ -48,8 +52,8 @@ class Snapshot:
     agent_emitting: np.ndarray
     pellet_xy: np.ndarray = None
     pellet_orientation: np.ndarray = None
-    width: float = 70.0
-    height: float = 70.0
+    width: float = _ARENA.width_cm
+    height: float = _ARENA.height_cm
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__

@@ -13,7 +13,10 @@ import math
 import torch
 from torch import nn
 
+from ..config.schema import TrainConfig
 from .distributions import ActionDistribution
+
+HEAD_GAIN = TrainConfig().head_gain  # the schema's train.head_gain: the default of both heads
 
 
 def _orthogonal(layer: nn.Linear, gain: float) -> nn.Linear:
@@ -68,7 +71,7 @@ class RecurrentTrunk(nn.Module):
 class Actor(nn.Module):
     """Policy: trunk -> (move/turn means, EOD/bite logits); log-std state-independent, init 0."""
 
-    def __init__(self, obs_dim: int, hidden: int, head_gain: float = 0.01):
+    def __init__(self, obs_dim: int, hidden: int, head_gain: float = HEAD_GAIN):
         super().__init__()
         self.trunk = RecurrentTrunk(obs_dim, hidden)
         self.head = _orthogonal(nn.Linear(hidden, 4), head_gain)
@@ -85,7 +88,7 @@ class Actor(nn.Module):
 class Critic(nn.Module):
     """Centralised value: trunk over the concatenated observations of all agents -> scalar."""
 
-    def __init__(self, state_dim: int, hidden: int, head_gain: float = 0.01):
+    def __init__(self, state_dim: int, hidden: int, head_gain: float = HEAD_GAIN):
         super().__init__()
         self.trunk = RecurrentTrunk(state_dim, hidden)
         self.head = _orthogonal(nn.Linear(hidden, 1), head_gain)

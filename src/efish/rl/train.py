@@ -254,8 +254,10 @@ def recorded_precision(state: dict) -> str:
 
 def _with_precision(config: dict, precision: str) -> dict:
     """A recorded training config with train.precision replaced by the precision actually used: what a resume
-    must match (auto and an explicit value agree when auto chose that value)."""
-    return {**config, "train": {**config["train"], "precision": precision}}
+    must match (auto and an explicit value agree when auto chose that value). The retired train.bf16 flag of older
+    checkpoints is dropped: :func:`recorded_precision` has read it."""
+    train = {k: v for k, v in config["train"].items() if k != "bf16"}
+    return {**config, "train": {**train, "precision": precision}}
 
 
 def restore_checkpoint(state: dict, path: Path, cfg: EfishConfig, compute: Compute, learner: Learner, env: VecEnv,

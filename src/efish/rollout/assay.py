@@ -11,6 +11,7 @@ import pandas as pd
 from ..config.compose import compose_variants
 from ..config.schema import EfishConfig
 from ..env.observe import observation_size
+from .conditions import conditions_table
 from .run import run_episodes
 
 
@@ -46,7 +47,7 @@ def run_assay(overrides: Sequence[str], policies: Mapping, progress: Callable | 
 
     ``policies``: policy name (``selected``, ``homing``, ...) -> a policy with ``obs_dim``, ``initial_hidden``
     and ``act`` (:class:`efish.rl.policy.Policy`). Returns the concatenated tables (``hidden`` too when
-    ``assay.record_hidden``) and run statistics (env steps, seconds, env-steps/s). Everything is checked
+    ``assay.record_hidden``; ``conditions``: what each condition resolved to) and run statistics (env steps, seconds, env-steps/s). Everything is checked
     before the first step: unknown policies and observation sizes that do not fit.
     """
     configs = condition_configs(overrides)
@@ -65,4 +66,5 @@ def run_assay(overrides: Sequence[str], policies: Mapping, progress: Callable | 
             progress(name)
     seconds = time.perf_counter() - start
     tables = {k: pd.concat([p[k] for p in parts], ignore_index=True) for k in parts[0]}
+    tables["conditions"] = conditions_table(configs)
     return tables, {"env_steps": env_steps, "seconds": seconds, "env_steps_per_s": env_steps / seconds}

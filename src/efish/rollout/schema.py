@@ -80,7 +80,28 @@ HIDDEN_COLUMNS = KEYS + STEP_KEYS[:1] + STEP_KEYS[2:]
 HIDDEN_UNITS = ("the policy's GRU state after taking in the observation of step t (the world of the steps row "
                 "with the same keys), before acting on it; one column per unit")
 
-COLUMNS = {"steps": STEP_COLUMNS, "episodes": EPISODE_COLUMNS, "food": FOOD_COLUMNS, "hidden": HIDDEN_COLUMNS}
+# One row per condition of an assay: what it resolved to in this run (every override applied), so that panels,
+# clips and claims read the run's own record instead of composing configs again (efish.config.recorded).
+CONDITION_COLUMNS = [
+    ("condition", pa.string(), "condition of the assay (config/assay/<name>.yaml)"),
+    ("position", I16, "its place in the assay's list; 0 is the control"),
+    ("overrides", pa.list_(pa.string()), "the condition's own config overrides (its interventions)"),
+    ("policy", pa.string(), "the trained policy that acts (selected, or a recipe of config/policy/)"),
+    ("episodes", I32, "episodes run"), ("seed", I32, "seed of the first episode"),
+    ("n_agents", I16, "agents per arena"),
+    ("sizes", pa.list_(F32), "fixed body size per agent; empty: U(0, 1) per episode"),
+    ("roles", pa.list_(pa.string()), "start placement per agent (random, resident, intruder, ...)"),
+    ("muted", pa.list_(I16), "agents that never emit"), ("frozen", pa.list_(I16), "agents that never move"),
+    ("bots", pa.list_(I16), "agents driven by the random-walk bot"),
+    ("bot_eod_rate", F32, "bot: probability of an EOD each step"),
+    ("arena_layout", pa.string(), "food layout of the arena"),
+    ("arena_width_cm", F32, "arena width, cm"), ("arena_height_cm", F32, "arena height, cm"),
+    ("fps", F64, "steps per second"), ("episode_steps", I32, "steps per episode (the scale's cap applied)"),
+    ("config", pa.string(), "the condition's whole resolved config as JSON (efish.config.recorded reads it back)"),
+]
+
+COLUMNS = {"steps": STEP_COLUMNS, "episodes": EPISODE_COLUMNS, "food": FOOD_COLUMNS, "hidden": HIDDEN_COLUMNS,
+           "conditions": CONDITION_COLUMNS}
 
 
 def arrow_schema(columns: list[tuple]) -> pa.Schema:
@@ -88,7 +109,7 @@ def arrow_schema(columns: list[tuple]) -> pa.Schema:
 
 
 STEPS, EPISODES, FOOD = arrow_schema(STEP_COLUMNS), arrow_schema(EPISODE_COLUMNS), arrow_schema(FOOD_COLUMNS)
-SCHEMAS = {"steps": STEPS, "episodes": EPISODES, "food": FOOD}
+SCHEMAS = {"steps": STEPS, "episodes": EPISODES, "food": FOOD, "conditions": arrow_schema(CONDITION_COLUMNS)}
 
 
 def hidden_schema(width: int) -> pa.Schema:
@@ -103,8 +124,8 @@ def describe(name: str) -> str:
     rows = [(n, str(k), d) for n, k, d in COLUMNS[name]]
     if name == "hidden":
         rows.append(("h_0 .. h_{H-1}", "float", HIDDEN_UNITS))
-    width = max(len(n) for n, _, _ in rows)
-    return "\n".join(f"{n:<{width}}  {k:<7}  {d}" for n, k, d in rows)
+    width, kind = max(len(n) for n, _, _ in rows), max(len(k) for _, k, _ in rows)
+    return "\n".join(f"{n:<{width}}  {k:<{kind}}  {d}" for n, k, d in rows)
 
 
 def to_table(df: pd.DataFrame, name: str) -> pa.Table:

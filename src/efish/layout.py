@@ -1,0 +1,196 @@
+"""Where every file of a run lives: the one home of the results layout.
+
+A run named ``<run>`` (the scale, or the scale and a hash of its overrides) keeps
+its tables under ``results/<run>/`` and its drawings under ``figures/<run>/``::
+
+    results/<run>/
+      train/<seed_N | policy>/        final.pt, metrics.parquet (training)
+      selection/seed_N/               episodes, steps, food (held-out patchy episodes)
+      analysis/selection/             ranking.parquet, selected_seed.txt
+      assays/<assay>/                 steps, episodes, food, conditions (, hidden) .parquet
+      analysis/<analysis>/<assay>/    the tables of efish.analysis.registry
+      seeds/<assay>/episodes.parquet  the top seeds' episodes stacked (supplement)
+      seeds/seed_N/                   another top seed's assays, analyses and claims, same layout
+      scenes/<scene>.parquet          field maps
+      claims/                         claims.parquet, claims.md
+      bench/                          benchmark tables
+      logs/, benchmarks/              one .log and one Snakemake .tsv per job
+    figures/<run>/
+      <figure>/<panel>.png|pdf, <figure>.png|pdf, clips/<assay>.gif, contact_sheet.png, bench/
+
+Panels and claims name a table by its path relative to ``results/<run>/`` (``assays/patchy4/steps.parquet``);
+the functions below build those names and :func:`parse_table` reads them back. :class:`Run` anchors them in a
+run's folders; the Snakemake rules pass wildcard names (``Run("{run}")``, ``assay="{assay}"``), so the rules,
+the CLI, the panels and the claims all share this one layout. Nothing here imports beyond the standard library.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import NamedTuple
+
+RESULTS_ROOT = Path("results")
+FIGURES_ROOT = Path("figures")
+
+# The tables an assay writes (hidden only where the assay records the GRU state) and their order.
+ROLLOUT_TABLES = ("steps", "episodes", "food", "conditions")
+RANKING = "analysis/selection/ranking.parquet"
+SELECTED_SEED = "analysis/selection/selected_seed.txt"
+CLAIMS_TABLE = "claims/claims.parquet"
+CLAIMS_PAGE = "claims/claims.md"
+FIGURE_FORMATS = ("png", "pdf")
+BENCH = "bench"  # the benchmarks' folder: tables under results/<run>/, figures under figures/<run>/
+BENCHMARKS = "benchmarks"  # Snakemake's per-job .tsv timings under results/<run>/
+CONTACT_SHEET = "contact_sheet.png"  # under figures/<run>/
+
+
+def seed_name(seed: int | str) -> str:
+    """A trained seed's folder name: ``seed_3`` (``seed_{seed}`` in a rule)."""
+    return f"seed_{seed}"
+
+
+def assay_folder(assay: str) -> str:
+    return f"assays/{assay}"
+
+
+def assay_table(assay: str, table: str) -> str:
+    """``assays/<assay>/<table>.parquet``: a rollout table (steps, episodes, food, conditions, hidden)."""
+    return f"{assay_folder(assay)}/{table}.parquet"
+
+
+def analysis_folder(analysis: str, assay: str) -> str:
+    return f"analysis/{analysis}/{assay}"
+
+
+def analysis_table(analysis: str, assay: str, table: str) -> str:
+    """``analysis/<analysis>/<assay>/<table>.parquet``: a table of an analysis of one assay."""
+    return f"{analysis_folder(analysis, assay)}/{table}.parquet"
+
+
+def training_folder(name: str) -> str:
+    """``train/<name>``: ``name`` is a seed's folder (:func:`seed_name`) or a policy recipe."""
+    return f"train/{name}"
+
+
+def training_file(name: str, file: str) -> str:
+    """``train/<name>/<file>``: ``name`` is a seed's folder (:func:`seed_name`) or a policy recipe."""
+    return f"{training_folder(name)}/{file}"
+
+
+def selection_table(seed: int | str, table: str) -> str:
+    """``selection/seed_N/<table>.parquet``: a seed's held-out episodes for the selection."""
+    return f"selection/{seed_name(seed)}/{table}.parquet"
+
+
+def stacked_seeds_table(assay: str) -> str:
+    """``seeds/<assay>/episodes.parquet``: the top seeds' episodes of an assay, with seed and rank columns."""
+    return f"seeds/{assay}/episodes.parquet"
+
+
+def scene_table(scene: str) -> str:
+    return f"scenes/{scene}.parquet"
+
+
+def bench_file(name: str) -> str:
+    """``bench/<name>``: a benchmark's table, JSON or figure."""
+    return f"{BENCH}/{name}"
+
+
+class TableId(NamedTuple):
+    """What a table path relative to ``results/<run>/`` names: ``kind`` is ``assays``, ``analysis`` or
+    ``seeds`` (the stacked top-seed tables); ``analysis`` is empty but for analysis tables."""
+
+    kind: str
+    assay: str
+    analysis: str
+    table: str
+
+
+def parse_table(path: str) -> TableId | None:
+    """The assay (and analysis) a relative table path names, or None for any other file (training, ranking,
+    scenes): the inverse of :func:`assay_table`, :func:`analysis_table` and :func:`stacked_seeds_table`."""
+    parts = path.split("/")
+    stem = parts[-1].removesuffix(".parquet")
+    if parts[0] == "assays" and len(parts) == 3:
+        return TableId("assays", parts[1], "", stem)
+    if parts[0] == "analysis" and len(parts) == 4:
+        return TableId("analysis", parts[2], parts[1], stem)
+    if parts[0] == "seeds" and len(parts) == 3 and not parts[1].startswith("seed_"):
+        return TableId("seeds", parts[1], "", stem)
+    return None
+
+
+@dataclass(frozen=True)
+class Run:
+    """The folders of one run. ``name`` may be a Snakemake wildcard (``{run}``); ``seed`` set means another top
+    seed's copy of the layout (``results/<run>/seeds/seed_N/``), whose logs and benchmark files stay under the
+    run's own ``logs/seeds/seed_N/`` and ``benchmarks/seeds/seed_N/`` so one folder times the whole run."""
+
+    name: str
+    seed: int | str | None = None
+    results_root: Path = RESULTS_ROOT
+    figures_root: Path = FIGURES_ROOT
+
+    @property
+    def results(self) -> Path:
+        """Where this run's (or this top seed's) tables live."""
+        root = Path(self.results_root) / self.name
+        return root if self.seed is None else root / "seeds" / seed_name(self.seed)
+
+    @property
+    def figures(self) -> Path:
+        return Path(self.figures_root) / self.name
+
+    def top_seed(self, seed: int | str) -> Run:
+        """Another top seed's copy of the layout."""
+        return Run(self.name, seed, self.results_root, self.figures_root)
+
+    def path(self, relative: str) -> Path:
+        """A file under the results folder, from a relative name of this module (e.g. :func:`assay_table`)."""
+        return self.results / relative
+
+    def _job_file(self, kind: str, job: str, suffix: str) -> Path:
+        seed = "" if self.seed is None else f"seeds/{seed_name(self.seed)}/"
+        return Path(self.results_root) / self.name / kind / f"{seed}{job}{suffix}"
+
+    def log(self, job: str) -> Path:
+        """``results/<run>/logs/<job>.log`` (``job`` may hold folders: ``assays/patchy4``)."""
+        return self._job_file("logs", job, ".log")
+
+    def benchmark(self, job: str) -> Path:
+        """``results/<run>/benchmarks/<job>.tsv``: Snakemake's timing of one job (``efish bench pipeline``)."""
+        return self._job_file(BENCHMARKS, job, ".tsv")
+
+    @property
+    def benchmarks(self) -> Path:
+        return Path(self.results_root) / self.name / BENCHMARKS
+
+    @property
+    def bench(self) -> Path:
+        """``results/<run>/bench/``: the benchmarks' tables (``efish bench ... --out``)."""
+        return self.results / BENCH
+
+    @property
+    def bench_figures(self) -> Path:
+        """``figures/<run>/bench/``: the benchmarks' figures (``efish bench accuracy|scaling --figures``)."""
+        return self.figures / BENCH
+
+    def panel(self, figure: str, panel: str, ext: str) -> Path:
+        """``figures/<run>/<figure>/<panel>.<ext>``."""
+        return self.figures / figure / f"{panel}.{ext}"
+
+    def page(self, figure: str, ext: str) -> Path:
+        """``figures/<run>/<figure>.<ext>``: a figure's page of every panel drawn at its scale."""
+        return self.figures / f"{figure}.{ext}"
+
+    def bench_figure(self, name: str, ext: str) -> Path:
+        """``figures/<run>/bench/<name>.<ext>``: a benchmark's figure."""
+        return self.bench_figures / f"{name}.{ext}"
+
+    def clip(self, assay: str, ext: str = "gif") -> Path:
+        return self.figures / "clips" / f"{assay}.{ext}"
+
+    @property
+    def contact_sheet(self) -> Path:
+        return self.figures / CONTACT_SHEET
