@@ -1,5 +1,6 @@
 """The ``efish`` command's own logic: the training log line; ``efish claims`` with the other top seeds' claims tables
-(seed_verdicts, seeds_agree) and ``efish compare-claims`` showing seeds_agree."""
+(seed_verdicts, seeds_agree), its parts table and the trends along training; ``efish claims-by-stage``; ``efish
+compare-claims`` showing seeds_agree."""
 
 from __future__ import annotations
 
@@ -8,8 +9,10 @@ import math
 import pandas as pd
 import pytest
 
-from efish.analysis.claim_parts import ROW_COLUMNS
+from efish.analysis.claim_parts import PART_COLUMNS, ROW_COLUMNS
 from efish.cli import ReturnLog, main
+
+from .analysis.test_claims_stages import STEPS, stage_parts
 
 
 def test_the_training_log_never_prints_nan():
@@ -32,10 +35,16 @@ def claims_rows(verdicts: dict[str, str]) -> pd.DataFrame:
 @pytest.fixture
 def seed_run(tmp_path, monkeypatch):
     """A run folder with a ranking (seed 3 selected, then 1 and 7) and the claims tables of seeds 1 and 7; the
-    selected seed's claims are a fixed table (claims_table is replaced: these tests are about the CLI)."""
+    selected seed's claims are a fixed table and its parts one row per claim (claims_and_parts is replaced: these
+    tests are about the CLI)."""
     from efish.analysis import claims
 
-    monkeypatch.setattr(claims, "claims_table", lambda results, cfg: claims_rows({"C1": "holds", "C9": "holds"}))
+    def fixed(results, cfg):
+        table = claims_rows({"C1": "holds", "C9": "holds"})
+        parts = table.rename(columns={"panel": "part"}).assign(sign=1.0, decides=True)[PART_COLUMNS]
+        return table, parts
+
+    monkeypatch.setattr(claims, "claims_and_parts", fixed)
     run = tmp_path / "results" / "myrun"
     (run / "analysis" / "selection").mkdir(parents=True)
     pd.DataFrame({"seed": [3, 1, 7, 2]}).to_parquet(run / "analysis" / "selection" / "ranking.parquet")
@@ -95,6 +104,62 @@ def test_efish_claims_refuses_bad_seed_tables_in_one_line_and_writes_nothing(see
     assert not (seed_run / "claims").exists()
 
 
+def test_efish_claims_writes_the_parts_table_and_the_trends_along_training(seed_run, tmp_path):
+    trends = tmp_path / "claims_trends.parquet"
+    assert main(["claims-by-stage", "scale=smoke", *stage_args(tmp_path), "--out", str(tmp_path / "learning"),
+                 "--figures", str(tmp_path / "figures")]) == 0
+    (tmp_path / "learning" / "claims_trends.parquet").rename(trends)
+    assert main(["claims", "scale=smoke", "--results", str(seed_run), "--trends", str(trends)]) == 0
+    parts = pd.read_parquet(seed_run / "claims" / "claim_parts.parquet")
+    assert list(parts.columns) == PART_COLUMNS and parts["claim"].tolist() == ["C1", "C9"]
+    page = (seed_run / "claims" / "claims.md").read_text()
+    assert "\n## Along training\n" in page and "- C3 (alignment): moving toward the paper's sign (WLS slope" in page
+    assert main(["claims", "scale=smoke", "--results", str(seed_run), "--trends", str(tmp_path / "none.parquet")]) == 2
+
+
+# ------------------------------------------------- efish claims-by-stage
+def stage_args(tmp_path, env_steps=STEPS) -> list[str]:
+    """--stages and --env-steps of four stages' parts tables: C3 growing in the paper's sign, C9 flat; stage 1 as a
+    claims folder, the others as files."""
+    tables = stage_parts({("C3", "alignment"): (-1, [-0.1, -0.2, -0.3, -0.4]), ("C9", "bites"): (+1, [0.3] * 4)})
+    paths = []
+    for k, table in tables.items():
+        folder = tmp_path / f"stage_{k}" / "claims"
+        folder.mkdir(parents=True)
+        table.to_parquet(folder / "claim_parts.parquet")
+        paths.append(f"{k}={folder if k == 1 else folder / 'claim_parts.parquet'}")
+    return ["--stages", *paths, "--env-steps", *(f"{k}={n}" for k, n in env_steps.items())]
+
+
+def test_efish_claims_by_stage_writes_the_stacked_table_the_trends_and_the_figure(tmp_path, capsys):
+    out, figures = tmp_path / "learning", tmp_path / "figures"
+    assert main(["claims-by-stage", "scale=smoke", *stage_args(tmp_path), "--episodes", "1=2", "2=4", "3=4", "4=4",
+                 "--out", str(out), "--figures", str(figures)]) == 0
+    stacked = pd.read_parquet(out / "claims_by_stage.parquet")
+    assert len(stacked) == 8 and stacked["episodes"].tolist()[:4] == [2, 4, 4, 4]
+    trends = pd.read_parquet(out / "claims_trends.parquet").set_index("claim")
+    assert trends.loc["C3", "trend"] == "moving toward the paper's sign" and trends.loc["C9", "trend"] == "stable"
+    assert {"config.yaml", "claims_by_stage.provenance.json"} <= {p.name for p in out.iterdir()}
+    assert (figures / "claims_by_stage.png").is_file() and (figures / "claims_by_stage.pdf").is_file()
+    text = capsys.readouterr().out
+    assert text.startswith("C3 (alignment): moving toward the paper's sign") and "claims_by_stage.png" in text
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda a: ["1=x" if x == "1=25000" else x for x in a], "--env-steps 1=x: N must be a whole number"),
+    (lambda a: [x for x in a if x != "4=100000"], "no env steps for stages [4]"),
+    (lambda a: [x.replace("stage_2", "stage_9") for x in a], "--stages 2: no parts table at"),
+    (lambda a: [*a[:2], a[1], *a[2:]], "--stages names k 1 twice"),
+])
+def test_efish_claims_by_stage_refuses_bad_stages_in_one_line_and_writes_nothing(tmp_path, capsys, change, message):
+    args = stage_args(tmp_path)
+    assert main(["claims-by-stage", "scale=smoke", *change(args), "--out", str(tmp_path / "out"),
+                 "--figures", str(tmp_path / "fig")]) == 2
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "out").exists() and not (tmp_path / "fig").exists()
+
+
 def test_compare_claims_shows_each_runs_seeds_agree_and_a_dash_without(tmp_path, capsys):
     from efish.analysis.claims_seeds import with_seed_verdicts
 
@@ -127,7 +192,7 @@ def test_every_command_has_a_handler_and_the_docstring_lists_it():
     import efish.cli as cli
 
     commands = _commands(cli._parser())
-    assert len(commands) == 23 and "bench scaling" in commands and "compare-claims" in commands
+    assert len(commands) == 24 and "bench scaling" in commands and "claims-by-stage" in commands and "compare-claims" in commands
     for name, parser in commands.items():
         assert callable(parser.get_default("handler")), name
     usage = {" ".join(line.split()[1:3]) if line.split()[1] == "bench" else line.split()[1]

@@ -13,9 +13,16 @@
     efish render assay=NAME [overrides] [--condition C] [--episode K] [--out F.gif|F.mp4] [--field]
                                               one episode of an assay as a clip, from its rollout tables
     efish contact-sheet [overrides] [--figures D] [--out F.png]   every panel's PNG as a thumbnail with its id
-    efish claims [overrides] [--results D] [--out D] [--ranking F] [--seed-claims SEED=F ...]
-                                              the paper's claims as verdicts -> claims.parquet, claims.md; with the
-                                              other top seeds' claims tables, seed_verdicts and seeds_agree too
+    efish claims [overrides] [--results D] [--out D] [--ranking F] [--seed-claims SEED=F ...] [--trends F]
+                                              the paper's claims as verdicts -> claims.parquet, claim_parts.parquet
+                                              (one row per part), claims.md; with the other top seeds' claims
+                                              tables, seed_verdicts and seeds_agree too; with a claims_trends.parquet,
+                                              an "Along training" section in claims.md
+    efish claims-by-stage [overrides] --stages K=PATH ... --env-steps K=N ... [--episodes K=N ...] [--out D]
+                          [--figures D]       the claims' parts at the kept training stages stacked, each part's
+                                              trend -> claims_by_stage.parquet, claims_trends.parquet (--out,
+                                              default results/<run>/learning) and claims_by_stage.png|pdf
+                                              (--figures, default figures/<run>/learning)
     efish compare-claims A B                  two runs' claim verdicts, seeds_agree and effects side by side
     efish scene NAME [overrides] --out D      field maps of config/scene/NAME.yaml -> D/NAME.parquet
     efish bench physics [overrides] [--json] [--out D]   sensing throughput, fast vs reference
@@ -52,8 +59,12 @@ from typing import Sequence
 from .config import ConfigError, compose, run_name, to_yaml
 from .layout import (
     BENCH,
+    CLAIM_PARTS,
+    CLAIMS_BY_STAGE,
+    CLAIMS_BY_STAGE_FIGURE,
     CLAIMS_PAGE,
     CLAIMS_TABLE,
+    CLAIMS_TRENDS,
     CONTACT_SHEET,
     RANKING,
     SELECTED_SEED,
@@ -151,7 +162,24 @@ def _parser() -> argparse.ArgumentParser:
     cl.add_argument("--ranking", type=Path,
                     help=f"the seed ranking, whose first row is the selected seed (default with --seed-claims: "
                          f"<results>/{RANKING}); alone it adds the seed columns too")
+    cl.add_argument("--trends", type=Path, help="a claims_trends.parquet (efish claims-by-stage): claims.md gains an "
+                                                "'Along training' section, one line per claim")
     cl.set_defaults(handler=_claims)
+    cbs = sub.add_parser("claims-by-stage", help="the claims' parts at the kept training stages, and whether each is "
+                                                 "still moving (a table, the trends, a figure)")
+    cbs.add_argument("overrides", nargs="*", help="config overrides (analysis.claims_trend_alpha; the run's name)")
+    cbs.add_argument("--stages", nargs="+", required=True, metavar="K=PATH",
+                     help="each stage's claim_parts.parquet, its claims folder, or its results folder "
+                          "(results/{run}/learning/stage_<k>)")
+    cbs.add_argument("--env-steps", nargs="+", required=True, metavar="K=N",
+                     help="the env steps trained at each stage (one per --stages entry)")
+    cbs.add_argument("--episodes", nargs="+", metavar="K=N",
+                     help="episodes per condition the stage's assays ran (adds an episodes column)")
+    cbs.add_argument("--out", type=Path, help="folder for claims_by_stage.parquet and claims_trends.parquet "
+                                              f"(default results/{{run}}/{Path(CLAIMS_BY_STAGE).parent})")
+    cbs.add_argument("--figures", type=Path, help="folder for claims_by_stage.png and .pdf "
+                                                  f"(default figures/{{run}}/{Path(CLAIMS_BY_STAGE_FIGURE).parent})")
+    cbs.set_defaults(handler=_claims_by_stage)
     cc = sub.add_parser("compare-claims", help="two runs' claim verdicts and effect sizes side by side")
     cc.add_argument("a", help="claims.parquet, a claims folder, or a run name (results/<name>/claims/claims.parquet)")
     cc.add_argument("b", help="the same for the second run")
@@ -370,16 +398,18 @@ def _scene(args, cfg, started) -> None:
 
 
 def _claims(args, cfg, started) -> None:
-    from .analysis.claims import claims_table
+    from .analysis import claims
     from .analysis.claims_report import claims_markdown
-    from .io import write_parquet_tables, write_text_atomic
+    from .analysis.claims_stages import trend_lines
+    from .io import read_parquet, write_parquet_tables, write_text_atomic
 
     results = args.results or _run(cfg, args.overrides).results
     if not results.is_dir():
         raise ValueError(f"results folder {results} does not exist")
     out = args.out or (results / CLAIMS_TABLE).parent
     seeds = _seed_claims(args, results)  # read before anything is computed or written
-    table = claims_table(results, cfg)
+    trends = None if args.trends is None else trend_lines(read_parquet(args.trends, "the claims' trends table"))
+    table, parts = claims.claims_and_parts(results, cfg)
     header = (f"Claims of the paper at scale {cfg.scale.name} (run {results.name}), "
               f"{started.strftime('%Y-%m-%d %H:%M UTC')}")
     if seeds is not None:
@@ -389,14 +419,15 @@ def _claims(args, cfg, started) -> None:
         table = with_seed_verdicts(table, others, selected)
         header += f"; selected seed {selected}" + (f", other top seeds {', '.join(map(str, others))}" if others else "")
     table_path, page_path = out / Path(CLAIMS_TABLE).name, out / Path(CLAIMS_PAGE).name
-    write_parquet_tables({table_path.stem: table}, out)
-    write_text_atomic(page_path, claims_markdown(table, header))
+    write_parquet_tables({table_path.stem: table, Path(CLAIM_PARTS).stem: parts}, out)
+    write_text_atomic(page_path, claims_markdown(table, header, trends))
     _metadata(out, cfg, started, args, results=str(results),
-              **({} if seeds is None else {"selected_seed": seeds[0], "other_seeds": list(seeds[1])}))
+              **({} if seeds is None else {"selected_seed": seeds[0], "other_seeds": list(seeds[1])}),
+              **({} if args.trends is None else {"trends": str(args.trends)}))
     shown = ["claim", "panel", "effect", "ci_low", "ci_high", "n", "p", "verdict"]
     print(table[shown + ["seeds_agree"] * ("seeds_agree" in table.columns)].to_string(
         index=False, float_format=lambda v: f"{v:.3g}"))
-    print(f"wrote {table_path} and {page_path}")
+    print(f"wrote {table_path}, {out / Path(CLAIM_PARTS).name} and {page_path}")
 
 
 def _seed_claims(args, results: Path):
@@ -413,20 +444,72 @@ def _seed_claims(args, results: Path):
     ranking = [int(s) for s in read_parquet(ranking_path, "the seed ranking")["seed"]]
     if not ranking:
         raise ValueError(f"the seed ranking {ranking_path} has no seed")
-    paths = {}
-    for item in args.seed_claims or []:
-        seed, sep, path = item.partition("=")
-        if not (sep and seed.strip().isdigit() and path):
-            raise ValueError(f"--seed-claims {item!r}: write SEED=PATH, e.g. 3=results/laptop/seeds/seed_3/claims/"
-                             "claims.parquet")
-        if int(seed) in paths:
-            raise ValueError(f"--seed-claims names seed {int(seed)} twice")
-        paths[int(seed)] = Path(path)
+    paths = {seed: Path(path) for seed, path in _keyed(
+        args.seed_claims, "--seed-claims", "SEED", "PATH", "3=results/laptop/seeds/seed_3/claims/claims.parquet").items()}
     if unknown := sorted(set(paths) - set(ranking)):
         raise ValueError(f"--seed-claims: seeds {unknown} are not in the ranking {ranking_path} "
                          f"(seeds {', '.join(map(str, ranking))})")
     ordered = sorted(paths, key=ranking.index)
     return ranking[0], {s: read_parquet(paths[s], f"seed {s}'s claims table") for s in ordered}
+
+
+def _keyed(items: Sequence[str] | None, flag: str, key: str, value: str, example: str) -> dict[int, str]:
+    """A flag's ``KEY=VALUE`` entries by integer key (a seed, a stage), in the order given: one line of error for
+    an entry without ``=``, a key that is no whole number, or a key given twice."""
+    found = {}
+    for item in items or []:
+        k, sep, v = item.partition("=")
+        if not (sep and k.strip().isdigit() and v):
+            raise ValueError(f"{flag} {item!r}: write {key}={value}, e.g. {example}")
+        if int(k) in found:
+            raise ValueError(f"{flag} names {key.lower()} {int(k)} twice")
+        found[int(k)] = v
+    return found
+
+
+def _stage_counts(items: Sequence[str] | None, flag: str) -> dict[int, int]:
+    """``--env-steps`` / ``--episodes``: ``K=N`` entries, N a whole number."""
+    counts = _keyed(items, flag, "K", "N", "1=250000")
+    if bad := [f"{k}={v}" for k, v in counts.items() if not v.strip().isdigit()]:
+        raise ValueError(f"{flag} {', '.join(bad)}: N must be a whole number, e.g. 1=250000")
+    return {k: int(v) for k, v in counts.items()}
+
+
+def _read_stage(k: int, where: Path):
+    """(path, table) of stage ``k``'s parts table, from its claim_parts.parquet, its claims folder or its results
+    folder."""
+    from .io import read_parquet
+
+    candidates = [where, where / Path(CLAIM_PARTS).name, where / CLAIM_PARTS]
+    path = next((c for c in candidates if c.is_file()), None)
+    if path is None:
+        raise ValueError(f"--stages {k}: no parts table at {', '.join(map(str, candidates))} (run efish claims "
+                         "there first)")
+    return path, read_parquet(path, f"stage {k}'s parts table")
+
+
+def _claims_by_stage(args, cfg, started) -> None:
+    from .analysis.claims_stages import claims_by_stage, stage_trends, trend_lines
+    from .figures.learning import plot_claims_by_stage
+    from .io import write_parquet_tables
+
+    run = _run(cfg, args.overrides)
+    out = args.out or run.path(CLAIMS_BY_STAGE).parent
+    figures = args.figures or (run.figures / CLAIMS_BY_STAGE_FIGURE).parent
+    read = {k: _read_stage(k, Path(p)) for k, p in _keyed(args.stages, "--stages", "K", "PATH",
+                                                           "1=results/laptop/learning/stage_1").items()}
+    env_steps, episodes = _stage_counts(args.env_steps, "--env-steps"), _stage_counts(args.episodes, "--episodes")
+    stacked = claims_by_stage({k: table for k, (_, table) in read.items()}, env_steps, episodes or None)
+    trends = stage_trends(stacked, cfg.analysis.claims_trend_alpha)
+    drawn = plot_claims_by_stage(stacked, figures / Path(CLAIMS_BY_STAGE_FIGURE).name, trends)
+    tables = write_parquet_tables({Path(CLAIMS_BY_STAGE).stem: stacked, Path(CLAIMS_TRENDS).stem: trends}, out)
+    inputs = {"stages": {str(k): str(path) for k, (path, _) in read.items()},
+              "env_steps": {str(k): n for k, n in env_steps.items()},
+              "episodes": {str(k): n for k, n in episodes.items()}}
+    _metadata(out, cfg, started, args, name="claims_by_stage.provenance.json", **inputs)
+    _metadata(figures, cfg, started, args, name="claims_by_stage.provenance.json", table=str(tables[0]))
+    print("\n".join(trend_lines(trends).values()))
+    print(f"wrote {', '.join(map(str, tables + drawn))}")
 
 
 def _compare_claims(args, cfg, started) -> None:

@@ -78,6 +78,16 @@ def training_file(name: str, file: str) -> str:
     return f"{training_folder(name)}/{file}"
 
 
+def stage_name(k: int | str) -> str:
+    """``stage_3``: the k-th kept training stage (k = 1..K in the order of ``train.keep_stages``)."""
+    return f"stage_{k}"
+
+
+def stage_file(k: int | str) -> str:
+    """``stage_3.pt``: the policy training kept at its k-th stage, beside final.pt (``stage_{k}.pt`` in a rule)."""
+    return f"{stage_name(k)}.pt"
+
+
 def selection_table(seed: int | str, table: str) -> str:
     """``selection/seed_N/<table>.parquet``: a seed's held-out episodes for the selection."""
     return f"selection/{seed_name(seed)}/{table}.parquet"
@@ -194,3 +204,12 @@ class Run:
     @property
     def contact_sheet(self) -> Path:
         return self.figures / CONTACT_SHEET
+
+
+# ------------------------------------------------ claims per part and along training (efish claims, claims-by-stage)
+CLAIM_PARTS = "claims/claim_parts.parquet"  # one row per part of each claim, beside claims.parquet
+#: The claims along training (``efish claims-by-stage``): the stages' parts stacked and each part's trend, under
+#: ``results/<run>/``, and their figure (``.png``, ``.pdf``) under ``figures/<run>/``.
+CLAIMS_BY_STAGE = "learning/claims_by_stage.parquet"
+CLAIMS_TRENDS = "learning/claims_trends.parquet"
+CLAIMS_BY_STAGE_FIGURE = "learning/claims_by_stage"

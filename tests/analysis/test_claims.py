@@ -17,7 +17,7 @@ from efish.analysis.behaviour import (
     food_vs_size,
     theil_per_episode,
 )
-from efish.analysis.claim_parts import ROW_COLUMNS, bootstrap_ci, combined_verdict, judge
+from efish.analysis.claim_parts import PART_COLUMNS, ROW_COLUMNS, bootstrap_ci, combined_verdict, judge, part_rows
 from efish.analysis.claims_report import claims_markdown, compare_claims, load_claims
 from efish.analysis.dynamics_tests import power_near_far, power_tests, size_tests
 from efish.analysis.interactions import size_role_tests
@@ -579,6 +579,32 @@ def test_the_workflow_inputs_are_the_claim_tables_the_scale_produces():
                           for t in needed)
 
 
+@pytest.mark.parametrize("cid, signs", [("C5", [np.nan] * 3), ("C7", [1.0] * 3), ("C10", None), ("C20", [-1.0] * 2)])
+def test_the_parts_rows_are_the_parts_of_the_claims_row(cid, signs):
+    """One row per part with its own effect, interval, p, verdict and the paper's sign; the claim's row (unchanged)
+    shows the first deciding part that ran."""
+    claim = cl.CLAIMS[cid]
+    tables = BUILDERS[cid](False)
+    row, parts = claim.assess(tables, CFG)
+    assert row == claim.run(tables, CFG)
+    rows = pd.DataFrame(part_rows(cid, parts), columns=PART_COLUMNS)
+    assert rows["part"].tolist() == [p.label for p in parts] and (rows["claim"] == cid).all()
+    if signs is not None:
+        np.testing.assert_array_equal(rows["sign"], signs)
+    else:  # C10: the K-off food part is "no difference" (sign 0), the others have a direction
+        assert 0.0 in set(rows["sign"]) and {1.0, -1.0} & set(rows["sign"])
+    shown = rows[rows["decides"] & ~rows["verdict"].isin(["not run", "not decidable"])].iloc[0]
+    assert (shown["effect"], shown["ci_low"], shown["ci_high"], shown["p"]) == (row["effect"], row["ci_low"],
+                                                                                 row["ci_high"], row["p"])
+
+
+def test_a_claim_that_did_not_run_has_one_part_row_saying_why():
+    row, parts = cl.CLAIMS["C1"].assess({}, CFG)
+    (only,) = part_rows("C1", parts)
+    assert only["verdict"] == "not run" and np.isnan(only["effect"]) and np.isnan(only["sign"])
+    assert only["reason"] == row["reason"]
+
+
 # ------------------------------------------------------------------ the CLI
 @pytest.fixture(scope="module")
 def results(tmp_path_factory):
@@ -613,6 +639,18 @@ def test_efish_claims_writes_the_table_and_the_page(results, tmp_path, capsys):
     main(["claims", "scale=smoke", "analysis.claims_resamples=20", "analysis.claims_fit_resamples=2",
           "--results", str(results), "--out", str(again)])
     pd.testing.assert_frame_equal(table, pd.read_parquet(again / "claims.parquet"))
+    parts = pd.read_parquet(out / "claim_parts.parquet")
+    assert list(parts.columns) == PART_COLUMNS and parts["claim"].unique().tolist() == list(cl.CLAIMS)
+    assert len(parts) > len(table) and (parts.groupby("claim").size()["C5"] == 3)
+    pd.testing.assert_frame_equal(parts, pd.read_parquet(again / "claim_parts.parquet"))
+
+
+def test_claims_and_parts_compute_both_tables_at_once(results):
+    cfg = cfg_with("scale=smoke", "analysis.claims_resamples=20", "analysis.claims_fit_resamples=2")
+    claims, parts = cl.claims_and_parts(results, cfg, ["C9", "C12"])
+    pd.testing.assert_frame_equal(claims, cl.claims_table(results, cfg, ["C9", "C12"]))
+    assert parts["claim"].unique().tolist() == ["C9", "C12"] and parts["decides"].dtype == bool
+    assert parts.set_index(["claim", "part"]).index.is_unique
 
 
 def test_compare_claims_prints_both_runs_side_by_side(results, tmp_path, capsys):

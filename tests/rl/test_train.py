@@ -131,3 +131,128 @@ def test_homing_return_rises_with_training(tmp_path):
     first, last = r[:8], r[-8:]
     stderr = np.sqrt(first.var(ddof=1) / 8 + last.var(ddof=1) / 8)
     assert last.mean() - first.mean() > 3 * stderr, (first, last)
+
+
+# ------------------------------------------------------------------ training stages (train.keep_stages)
+STAGES = "train.keep_stages=[0.25,0.5,1.0]"
+TIMING = ["wall_s", "env_steps_per_s"]
+
+
+def stage_weights(path, k):
+    return torch.load(path / f"stage_{k}.pt", weights_only=False)["actor"]
+
+
+def assert_same(a, b):
+    for key in a:
+        torch.testing.assert_close(a[key], b[key], rtol=0, atol=0)
+
+
+def test_stage_updates_are_the_first_to_reach_each_fraction():
+    from efish.rl.train import stage_updates
+
+    assert stage_updates([0.25, 0.5, 0.75, 1.0], 4) == [1, 2, 3, 4]
+    assert stage_updates([0.3, 0.5, 1.0], 10) == [3, 5, 10]  # 0.3 * 10 is 3.0000000000000004 in floats
+    assert stage_updates([0.1, 0.26, 1.0], 4) == [1, 2, 4]
+    assert stage_updates([0.2, 0.4], 1) == [1, 1]
+    assert stage_updates([], 7) == []
+
+
+def test_stages_are_kept_at_their_updates_and_change_nothing(tmp_path):
+    from efish.rl.policy import load_policy, read_stage
+    from efish.rl.train import stage_paths
+
+    plain, staged, short = tmp_path / "plain", tmp_path / "staged", tmp_path / "short"
+    a = train(tiny(4, "train.checkpoint_every=3"), plain)
+    b = train(tiny(4, "train.checkpoint_every=3", STAGES), staged)  # stages at updates 1, 2, 4
+    pd.testing.assert_frame_equal(a.drop(columns=TIMING), b.drop(columns=TIMING))
+    pd.testing.assert_frame_equal(pd.read_parquet(plain / METRICS).drop(columns=TIMING),
+                                  pd.read_parquet(staged / METRICS).drop(columns=TIMING))
+    final_a, final_b = (torch.load(p / FINAL, weights_only=False) for p in (plain, staged))
+    for net in ("actor", "critic"):
+        assert_same(final_a[net], final_b[net])
+    paths = stage_paths(staged, [0.25, 0.5, 1.0])
+    assert [p.name for p in paths] == ["stage_1.pt", "stage_2.pt", "stage_3.pt"]
+    records = [read_stage(p) for p in paths]
+    assert [(r["k"], r["fraction"], r["update"], r["env_steps"], r["total_updates"]) for r in records] == [
+        (1, 0.25, 1, 40, 4), (2, 0.5, 2, 80, 4), (3, 1.0, 4, 160, 4)]
+    assert not list(plain.glob("stage_*.pt"))
+    # each stage is the checkpoint of its update: its metrics end there, and stage 2 is a 2-update run's final.pt
+    for p, r in zip(paths, records, strict=True):
+        assert [row["update"] for row in torch.load(p, weights_only=False)["metrics"]] == list(range(1, r["update"] + 1))
+    train(tiny(2), short)
+    assert_same(stage_weights(staged, 2), torch.load(short / FINAL, weights_only=False)["actor"])
+    assert_same(stage_weights(staged, 3), final_b["actor"])  # fraction 1.0 is the final policy
+    # load_policy reads a stage file and acts as the policy of that update
+    obs = np.random.default_rng(0).normal(size=(3, 2, load_policy(short).obs_dim)).astype(np.float32)
+    policy, reference = load_policy(paths[1]), load_policy(short / FINAL)
+    h = policy.initial_hidden(3)
+    np.testing.assert_array_equal(policy.act(obs, h, np.ones(3))[1], reference.act(obs, h, np.ones(3))[1])
+    with pytest.raises(ValueError, match="not a training stage"):
+        read_stage(short / FINAL)
+
+
+class Killed(Exception):
+    pass
+
+
+def kill_after(n: int):
+    """A progress callback that stops training during update ``n + 1``, before its checkpoint: the last
+    checkpoint is the one of update ``n`` or before (as a SIGKILL there leaves it)."""
+    def progress(row, total):
+        if row["update"] > n:
+            raise Killed
+    return progress
+
+
+def test_an_interrupted_run_keeps_its_stages_and_writes_the_rest(tmp_path):
+    straight, killed = tmp_path / "straight", tmp_path / "killed"
+    cfg = tiny(4, "train.checkpoint_every=3", "train.keep_stages=[0.5,1.0]")  # stages at updates 2 and 4
+    train(cfg, straight)
+    with pytest.raises(Killed):
+        train(cfg, killed, progress=kill_after(2))  # killed in update 3, checkpoint of update 2 (forced by stage 1)
+    assert torch.load(killed / CHECKPOINT, weights_only=False)["update"] == 2
+    first = (killed / "stage_1.pt").stat()
+    assert not (killed / "stage_2.pt").exists()
+    df = train(cfg, killed)
+    assert list(df["update"]) == [1, 2, 3, 4]
+    again = (killed / "stage_1.pt").stat()
+    assert (again.st_ino, again.st_mtime_ns) == (first.st_ino, first.st_mtime_ns)  # kept, not rewritten
+    for k in (1, 2):
+        assert_same(stage_weights(straight, k), stage_weights(killed, k))
+    assert_same(stage_weights(killed, 2), torch.load(killed / FINAL, weights_only=False)["actor"])
+
+
+def test_a_missing_stage_is_written_from_the_checkpoint_of_its_update_or_is_one_clear_error(tmp_path):
+    cfg = tiny(2, "train.keep_stages=[0.5,1.0]")
+    train(cfg, tmp_path)
+    before = stage_weights(tmp_path, 2)
+    (tmp_path / "stage_2.pt").unlink()   # killed between the last checkpoint and its stage
+    (tmp_path / FINAL).unlink()
+    train(cfg, tmp_path)                 # a finished run rerun: no update, the stage from the checkpoint
+    assert_same(stage_weights(tmp_path, 2), before)
+    (tmp_path / "stage_1.pt").unlink()   # its update is behind the checkpoint: it cannot be recreated
+    with pytest.raises(ValueError, match=r"stage_1\.pt \(train\.keep_stages fraction 0\.5, update 1\).*--restart"):
+        train(cfg, tmp_path)
+    train(tiny(2), tmp_path, restart=True)  # --restart discards the stages too
+    assert not list(tmp_path.glob("stage_*.pt"))
+
+
+def test_a_checkpoint_without_stages_resumes_with_them(tmp_path):
+    from efish.rl.policy import read_stage
+
+    train(tiny(1), tmp_path)                                  # no keep_stages: result-neutral
+    df = train(tiny(2, "train.keep_stages=[0.5,1.0]"), tmp_path)
+    assert list(df["update"]) == [1, 2]
+    assert [read_stage(tmp_path / f"stage_{k}.pt")["update"] for k in (1, 2)] == [1, 2]
+    with pytest.raises(ValueError, match=r"stage_1\.pt .*from another plan.*update 2"):
+        train(tiny(2, "train.keep_stages=[0.25,1.0]"), tmp_path)  # 0.25 of 2 updates is update 1, kept as 0.5
+
+
+@pytest.mark.parametrize("value", ["[0]", "[1.5]", "[-0.25]", "[0.5,0.25]", "[0.5,0.5]", "[a]", "[true]"])
+def test_bad_keep_stages_are_one_line_errors(value):
+    from efish.config import ConfigError
+
+    with pytest.raises(ConfigError) as info:
+        compose(TINY + [f"train.keep_stages={value}"])
+    assert str(info.value).startswith("train.keep_stages=") and "\n" not in str(info.value)
+    assert "strictly increasing fractions in (0, 1]" in str(info.value)

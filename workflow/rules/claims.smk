@@ -1,5 +1,5 @@
 # Claims: one job reading every table the claims registry (efish.analysis.claims.CLAIMS) names that this scale
-# produces, writing claims.parquet and claims.md. A claim whose tables the scale does not produce is written as
+# produces, writing claims.parquet, claim_parts.parquet (one row per tested part) and claims.md. A claim whose tables the scale does not produce is written as
 # "not run" with the missing table named (efish claims never fails on it).
 # Verdicts across seeds. Each top seed other than the selected one gets its own claims table from its rerun assays
 # (top_seed_claims, in its copy of the layout); the claims job adds their verdicts to the selected seed's as
@@ -13,6 +13,7 @@ rule claims:
         seeds=other_seed_claims,
     output:
         table=results(CLAIMS_TABLE),
+        parts=results(CLAIM_PARTS),
         page=report(results(CLAIMS_PAGE), caption="../report/claims.rst", category="Claims"),
     log:
         log("claims"),
@@ -34,6 +35,7 @@ use rule claims as top_seed_claims with:
         tables=claims_inputs,
     output:
         table=results(CLAIMS_TABLE, "{seed}"),
+        parts=results(CLAIM_PARTS, "{seed}"),
         page=results(CLAIMS_PAGE, "{seed}"),
     log:
         log("claims", "{seed}"),

@@ -17,6 +17,7 @@ from efish.rollout.assay import check_observation_sizes, condition_configs, poli
 from efish.figures.registry import PANELS, drawable
 from efish.figures.render import input_paths
 from efish.layout import (
+    CLAIM_PARTS,
     CLAIMS_PAGE,
     CLAIMS_TABLE,
     FIGURE_FORMATS,
@@ -299,5 +300,5 @@ def all_targets():
                 for path in analysis_outputs(an, THIS_RUN, a).values()]
     targets += [path for figure in FIGURE_PANELS for path in figure_outputs(figure, THIS_RUN)]
     targets += render_targets()
-    targets += [results(CLAIMS_TABLE, run=THIS_RUN), results(CLAIMS_PAGE, run=THIS_RUN)]
+    targets += [results(name, run=THIS_RUN) for name in (CLAIMS_TABLE, CLAIM_PARTS, CLAIMS_PAGE)]
     return targets

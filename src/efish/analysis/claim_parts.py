@@ -3,7 +3,9 @@
 A claim of CLAIMS.md often says several things at once (C10: two ablations cut
 food, a third keeps it and raises EOD probability...). Each thing is one
 :class:`Part`: an effect with the paper's sign, a p-value, an n, a bootstrap
-interval and a verdict; :func:`combine` makes the claim's one row of them.
+interval and a verdict; :func:`combine` makes the claim's one row of them and
+:func:`part_rows` a row per part (``claim_parts.parquet``, which keeps each
+part's effect and interval, e.g. to follow them along training).
 
 Verdicts (CLAIMS.md): **holds** = the paper's sign and p < alpha; **weaker** =
 the paper's sign but not significant (an effect of the opposite sign that is not
@@ -53,6 +55,11 @@ from .stats import mann_whitney, spearman, wilcoxon_paired
 
 VERDICTS = ("holds", "weaker", "fails", "not decidable", "not run")
 ROW_COLUMNS = ["claim", "panel", "statistic", "effect", "ci_low", "ci_high", "n", "p", "verdict", "reason"]
+#: One row per (claim, part) (:func:`part_rows`): the part's label, its statistic, the paper's sign (+1, -1; 0 for
+#: "no difference"; NaN for "any difference" or a part that did not run), its effect, interval, n, the p its
+#: verdict rests on, its verdict, whether it decides the claim, and its reason.
+PART_COLUMNS = ["claim", "part", "statistic", "sign", "effect", "ci_low", "ci_high", "n", "p", "verdict", "decides",
+                "reason"]
 NAN_CI = (np.nan, np.nan)
 
 
@@ -90,7 +97,8 @@ class Outcome:
 
 @dataclass(frozen=True)
 class Part:
-    """One tested statement of a claim, with its verdict."""
+    """One tested statement of a claim, with its verdict and the paper's sign (:class:`Outcome`; None when the
+    part did not run)."""
 
     label: str
     statistic: str
@@ -101,6 +109,7 @@ class Part:
     verdict: str = "not run"
     reason: str = ""
     decides: bool = True
+    sign: int | None = None
 
 
 def judge(effect: float, p: float, sign: int | None, alpha: float, p_equiv: float = np.nan,
@@ -145,7 +154,8 @@ def evaluate(label: str, statistic: str, compute: Callable[[], Outcome], alpha: 
     except KeyError as exc:  # a table from an older run without a column this claim reads
         return Part(label, statistic, reason=f"a table lacks the column or key {exc}", decides=decides)
     p = out.p_equiv if out.sign == 0 and out.verdict is None else out.p
-    base = Part(label, statistic, float(out.effect), tuple(map(float, out.ci)), int(out.n), float(p), decides=decides)
+    base = Part(label, statistic, float(out.effect), tuple(map(float, out.ci)), int(out.n), float(p), decides=decides,
+                sign=out.sign)
     if out.verdict is not None:
         return Part(**{**base.__dict__, "verdict": out.verdict, "reason": out.reason})
     if not (np.isfinite(out.effect) and np.isfinite(p)):
@@ -196,6 +206,16 @@ def combine(claim: str, panel: str, parts: list[Part]) -> dict:
     return {"claim": claim, "panel": panel, "statistic": statistic, "effect": shown.effect,
             "ci_low": shown.ci[0], "ci_high": shown.ci[1], "n": shown.n, "p": shown.p,
             "verdict": combined_verdict(p.verdict for p in deciding), "reason": reason}
+
+
+def part_rows(claim: str, parts: Iterable[Part]) -> list[dict]:
+    """The claim's rows of :data:`PART_COLUMNS`, one per part in the claim's order (the row :func:`combine` makes
+    summarises them in its reason; these keep each part's effect, interval and p, e.g. to follow them along
+    training, :mod:`efish.analysis.claims_stages`)."""
+    return [{"claim": claim, "part": p.label, "statistic": p.statistic,
+             "sign": np.nan if p.sign is None else float(p.sign), "effect": p.effect, "ci_low": p.ci[0],
+             "ci_high": p.ci[1], "n": p.n, "p": p.p, "verdict": p.verdict, "decides": p.decides, "reason": p.reason}
+            for p in parts]
 
 
 # ---------------------------------------------------------------- bootstrap
@@ -360,31 +380,43 @@ class Context:
 
 @dataclass(frozen=True)
 class Claim:
-    """A claim of CLAIMS.md: id, figure panels, the tables it reads, and its function (tables, cfg) -> row."""
+    """A claim of CLAIMS.md: id, figure panels, the tables it reads, and its function (tables, cfg) -> its parts.
+
+    :meth:`assess` gives the claim's row and its parts from one computation; :meth:`run` the row alone.
+    """
 
     id: str
     panel: str
     statement: str
     tables: tuple[str, ...]
-    run: Callable[[Tables, EfishConfig], dict]
+    parts: Callable[[Tables, EfishConfig], list[Part]]
+
+    def assess(self, tables: Tables, cfg: EfishConfig) -> tuple[dict, list[Part]]:
+        """The claim's row (:data:`ROW_COLUMNS`, :func:`combine`) and the parts it combines."""
+        found = self.parts(tables, cfg)
+        return combine(self.id, self.panel, found), found
+
+    def run(self, tables: Tables, cfg: EfishConfig) -> dict:
+        """The claim's row (:data:`ROW_COLUMNS`)."""
+        return self.assess(tables, cfg)[0]
 
 
 CLAIMS: dict[str, Claim] = {}
 
 
 def claim(cid: str, panel: str, statement: str, tables: Iterable[str]):
-    """Register a claim: wraps ``parts(ctx) -> [Part]`` into ``fn(tables, cfg) -> row`` and lists it in CLAIMS."""
+    """Register a claim: wraps ``parts(ctx) -> [Part]`` into ``fn(tables, cfg) -> [Part]``, lists it in CLAIMS
+    and returns its :meth:`Claim.run` (``fn(tables, cfg) -> row``)."""
     def register(parts: Callable[[Context], list[Part]]) -> Callable[[Tables, EfishConfig], dict]:
         @functools.wraps(parts)
-        def run(tables: Tables, cfg: EfishConfig) -> dict:
+        def found(tables: Tables, cfg: EfishConfig) -> list[Part]:
             try:
-                found = parts(Context(cid, tables, cfg))
+                return parts(Context(cid, tables, cfg))
             except (MissingTable, ValueError) as exc:  # a part that could not even be set up
-                found = [Part(cid, statement, reason=str(exc))]
-            return combine(cid, panel, found)
+                return [Part(cid, statement, reason=str(exc))]
 
-        CLAIMS[cid] = Claim(cid, panel, statement, tuple(tables), run)
-        return run
+        CLAIMS[cid] = Claim(cid, panel, statement, tuple(tables), found)
+        return CLAIMS[cid].run
     return register
 
 

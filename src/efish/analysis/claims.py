@@ -11,7 +11,9 @@ the interval resamples episodes of the table it rests on. A table the run lacks
 makes that part ``not run`` with a reason naming it, never an exception.
 
 :data:`CLAIMS` names, per claim, the tables it reads; ``efish claims`` and the
-``claims`` rule of the workflow read it, and :func:`claims_table` runs all.
+``claims`` rule of the workflow read it, and :func:`claims_table` runs all;
+:func:`claims_and_parts` also gives one row per part of each claim
+(:data:`PART_COLUMNS`) from the same computation.
 
 Condition names are those of ``config/assay/<assay>.yaml``.
 """
@@ -34,6 +36,7 @@ from . import claims_fig4  # noqa: F401  (registers C10-C13)
 from ._tables import AGENT_EPISODE, eod_rate
 from .claim_parts import (
     CLAIMS,
+    PART_COLUMNS,
     ROW_COLUMNS,
     Context,
     Outcome,
@@ -49,6 +52,7 @@ from .claim_parts import (
     ols_part,
     one_sample_part,
     paired_difference,
+    part_rows,
     present,
     rho_of,
     slope,
@@ -66,7 +70,8 @@ from .registry import ANALYSES, tables_written
 from .signalling import EVENTS, fit_power_law, peri_event_rate
 from .stats import spearman
 
-__all__ = ["CLAIMS", "ROW_COLUMNS", "claim_tables", "claims_table", "produced_tables"]
+__all__ = ["CLAIMS", "PART_COLUMNS", "ROW_COLUMNS", "claim_tables", "claims_and_parts", "claims_table",
+           "produced_tables"]
 
 
 # --------------------------------------------------------------- Fig 2
@@ -605,14 +610,27 @@ def read_claim_tables(results: str | Path, paths: Iterable[str]) -> dict[str, pd
     return {p: read_parquet(results / p, p) for p in paths if (results / p).is_file()}
 
 
-def claims_table(results: str | Path, cfg: EfishConfig, claims: Iterable[str] | None = None) -> pd.DataFrame:
-    """One row per claim (all of CLAIMS, or ``claims``) from the tables under ``results`` (``results/{run}``)."""
+def claims_and_parts(results: str | Path, cfg: EfishConfig,
+                     claims: Iterable[str] | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The claims table (one row per claim, :data:`ROW_COLUMNS`) and the parts table (one row per part of each
+    claim, :data:`PART_COLUMNS`) of all of CLAIMS, or ``claims``, from the tables under ``results``
+    (``results/{run}``): each claim is computed once and both tables come from that computation."""
     chosen = list(CLAIMS) if claims is None else list(claims)
     if unknown := [c for c in chosen if c not in CLAIMS]:
         raise ValueError(f"unknown claims {unknown}: choose among {', '.join(CLAIMS)}")
     tables = read_claim_tables(results, {t for c in chosen for t in CLAIMS[c].tables})
-    rows = [CLAIMS[c].run({t: tables[t] for t in CLAIMS[c].tables if t in tables}, cfg) for c in chosen]
-    return pd.DataFrame(rows, columns=ROW_COLUMNS).astype({"n": "int64"})
+    rows, parts = [], []
+    for c in chosen:
+        row, found = CLAIMS[c].assess({t: tables[t] for t in CLAIMS[c].tables if t in tables}, cfg)
+        rows.append(row)
+        parts += part_rows(c, found)
+    return (pd.DataFrame(rows, columns=ROW_COLUMNS).astype({"n": "int64"}),
+            pd.DataFrame(parts, columns=PART_COLUMNS).astype({"n": "int64", "sign": "float64", "decides": bool}))
+
+
+def claims_table(results: str | Path, cfg: EfishConfig, claims: Iterable[str] | None = None) -> pd.DataFrame:
+    """One row per claim (all of CLAIMS, or ``claims``) from the tables under ``results`` (``results/{run}``)."""
+    return claims_and_parts(results, cfg, claims)[0]
 
 
 # claims_fig4 registered C10-C13 on import, before this module's claims: list them in the paper's order

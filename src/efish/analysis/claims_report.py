@@ -6,6 +6,7 @@ A claims table is the output of :func:`efish.analysis.claims.claims_table`
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
@@ -26,10 +27,11 @@ def _effects(table: pd.DataFrame) -> list[str]:
             for e, lo, hi in zip(table["effect"], table["ci_low"], table["ci_high"], strict=True)]
 
 
-def claims_markdown(table: pd.DataFrame, header: str) -> str:
+def claims_markdown(table: pd.DataFrame, header: str, trends: Mapping[str, str] | None = None) -> str:
     """The claims table as markdown under a ``header`` line: claim, panel, statistic, effect [95% CI], n, p, verdict,
     seeds_agree (when the table has it: the verdicts across the top seeds, :mod:`efish.analysis.claims_seeds`),
-    reason (what the README quotes and the Snakemake report shows)."""
+    reason (what the README quotes and the Snakemake report shows); with ``trends`` (claim -> line,
+    :func:`efish.analysis.claims_stages.trend_lines`) the section :func:`along_training` after it."""
     shown = pd.DataFrame({
         "claim": table["claim"], "panel": table["panel"], "statistic": table["statistic"],
         "effect [95% CI]": _effects(table), "n": table["n"], "p": [_num(p) for p in table["p"]],
@@ -39,7 +41,18 @@ def claims_markdown(table: pd.DataFrame, header: str) -> str:
     shown["reason"] = table["reason"]
     counts = table["verdict"].value_counts()
     summary = ", ".join(f"{counts[v]} {v}" for v in VERDICTS if v in counts)
-    return f"{header}\n\n{summary}.\n\n{markdown_table(shown)}"
+    page = f"{header}\n\n{summary}.\n\n{markdown_table(shown)}"
+    return page if trends is None else f"{page}\n{along_training(trends)}"
+
+
+def along_training(lines: Mapping[str, str]) -> str:
+    """The "Along training" section of claims.md: how the test reads, then one bullet per claim's trend line."""
+    how = ("Each part's effect at the kept training stages (efish claims-by-stage): the weighted least-squares "
+           "slope of the effect (of |effect| where the paper reports no difference or a difference of either sign) "
+           "on log10 env steps, each stage weighted by its bootstrap interval, z-test at "
+           "analysis.claims_trend_alpha; the slope's interval in brackets.")
+    bullets = "\n".join(f"- {line}" for line in lines.values()) or "- no part has stages to compare"
+    return f"## Along training\n\n{how}\n\n{bullets}\n"
 
 
 def load_claims(where: str | Path, results_root: str | Path = RESULTS_ROOT) -> tuple[str, pd.DataFrame]:

@@ -251,6 +251,9 @@ class TrainConfig:
     total_steps: int = param("${scale.train_steps}", "env steps per seed (arena steps x arenas); a longer run "
                              "resumes a shorter one's checkpoint", lo=1, neutral=True)
     checkpoint_every: int = param(10, "updates between checkpoints", lo=1, neutral=True)
+    keep_stages: list = param([], "fractions of the run (in (0, 1], increasing) at which to keep the policy as "
+                              "stage_<k>.pt beside checkpoint.pt: the first update whose env steps reach that "
+                              "fraction of the run's, always checkpointed; [] = none", neutral=True)
     threads: int = param(1, "torch threads", lo=1, hi=256, neutral=True)
     precision: str = param("auto", "arithmetic of the update's forward passes: fp32, bf16 autocast, or auto (time "
                            "the training GEMM in both at start, take the faster; recorded in provenance.json)",
@@ -408,6 +411,9 @@ class AnalysisConfig:
     claims_food_near_cm: float = param(5.0, "food this close is in range when food variables are decoded near vs "
                                        "far (dynamics food_decoding, Fig 6F, claim C19): the authors' Mormyromast "
                                        "food range, 5 cm", lo=0.0)
+    claims_trend_alpha: float = param(0.05, "claims along training (efish claims-by-stage): a part's effect moves "
+                                      "toward or away from the paper's sign when the z-test of its weighted slope "
+                                      "on log10 env steps gives p below this", lo=0.0, hi=1.0)
 
 
 # ----------------------------------------------------------------------- scene
@@ -524,6 +530,11 @@ def _check_consistency(obj: Any, path: str) -> None:
         raise ConfigError(f"{path}conditions is empty: an assay needs at least one condition")
     if isinstance(obj, TrainConfig) and obj.rollout_steps % obj.chunk:
         raise ConfigError(f"{path}chunk={obj.chunk} must divide {path}rollout_steps={obj.rollout_steps}")
+    if isinstance(obj, TrainConfig):
+        stages = list(obj.keep_stages)
+        if (any(isinstance(f, bool) or not isinstance(f, (int, float)) or not 0 < f <= 1 for f in stages)
+                or stages != sorted(set(stages))):
+            raise ConfigError(f"{path}keep_stages={stages} must hold strictly increasing fractions in (0, 1]")
     if isinstance(obj, EnvConfig):
         if obj.n_agents > obj.obs_agents:
             raise ConfigError(f"{path}n_agents={obj.n_agents} exceeds {path}obs_agents={obj.obs_agents} (observation slots)")

@@ -45,7 +45,8 @@ class Policy:
 
 
 def load_policy(path: str | Path) -> Policy:
-    """The actor of a checkpoint: a file, or a training folder (its final.pt, else its latest checkpoint.pt)."""
+    """The actor of a checkpoint: a file (final.pt, checkpoint.pt, a stage_<k>.pt of ``train.keep_stages``), or a
+    training folder (its final.pt, else its latest checkpoint.pt)."""
     path = Path(path)
     if path.is_dir():
         path = path / FINAL if (path / FINAL).exists() else path / CHECKPOINT
@@ -59,3 +60,16 @@ def load_policy(path: str | Path) -> Policy:
     except Exception as exc:
         raise ValueError(f"cannot load a policy from {path}: {type(exc).__name__}") from None
     return Policy(actor, arch["n_agents"])
+
+
+def read_stage(path: str | Path) -> dict:
+    """The record of a stage file (``train.keep_stages``): ``k``, ``fraction``, ``update``, ``env_steps`` (at the
+    end of that update) and the run's ``total_updates``; one clear error for any other file."""
+    path = Path(path)
+    try:
+        record = torch.load(path, weights_only=False, map_location="cpu")["stage"]
+    except FileNotFoundError:
+        raise ValueError(f"no stage file at {path}") from None
+    except Exception as exc:
+        raise ValueError(f"{path} is not a training stage (train.keep_stages): {type(exc).__name__}") from None
+    return dict(record)

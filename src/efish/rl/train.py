@@ -6,11 +6,14 @@ holds the networks, optimisers, value normaliser, every RNG state, the
 environment state and the precision the run computes in, so a resumed run ends
 with the same weights as an uninterrupted one. The networks and the update run
 on ``train.device``; the environment and every random draw stay on the CPU.
+``train.keep_stages`` keeps the policy at fractions of the run as ``stage_<k>.pt``
+(:func:`stage_updates` says where), a checkpoint each: training is unchanged.
 """
 
 from __future__ import annotations
 
 import logging
+import math
 import shutil
 import time
 from pathlib import Path
@@ -22,6 +25,7 @@ import torch
 from ..config.schema import EfishConfig, config_differences, result_neutral_keys, training_config
 from ..env.vec_env import VecEnv
 from ..io import atomic_path, remove_partial_writes
+from ..layout import stage_file
 from ..physics.geometry import conspecific_slots
 from .advantages import gae
 from .compute import Compute, resolve_compute, resolve_device
@@ -140,7 +144,8 @@ def collect(cfg: EfishConfig, env: VecEnv, learner: Learner, carry: dict, genera
 
 
 def train(cfg: EfishConfig, out_dir: str | Path, progress=None, restart: bool = False) -> pd.DataFrame:
-    """Train one seed into ``out_dir`` (checkpoint.pt, metrics.parquet, and final.pt at the end).
+    """Train one seed into ``out_dir`` (checkpoint.pt, metrics.parquet, and final.pt at the end; stage_<k>.pt on
+    the way for ``train.keep_stages``, see :func:`stages_to_write`).
 
     Resumes from a checkpoint there only when it was written under the same
     config (apart from the schema's result-neutral keys: threads, device,
@@ -162,6 +167,8 @@ def train(cfg: EfishConfig, out_dir: str | Path, progress=None, restart: bool = 
     if restart:
         for name in (CHECKPOINT, FINAL, METRICS):
             (out / name).unlink(missing_ok=True)
+        for path in out.glob(stage_file("*")):
+            path.unlink()
     state = read_checkpoint(out / CHECKPOINT) if (out / CHECKPOINT).exists() else None
     compute = resolve_compute(cfg, recorded_precision(state) if state else None)
     LOG.info("networks on %s, precision %s (%s%s)", compute.device, compute.precision, compute.chosen_by,
@@ -171,12 +178,15 @@ def train(cfg: EfishConfig, out_dir: str | Path, progress=None, restart: bool = 
     generator = torch.Generator().manual_seed(t_cfg.seed)
     steps_per_update = t_cfg.rollout_steps * t_cfg.num_envs
     total_updates = max(1, t_cfg.total_steps // steps_per_update)
+    plan = stage_plan(t_cfg.keep_stages, total_updates, steps_per_update)
     rows, update = [], 0
     if state is not None:
         update, rows = restore_checkpoint(state, out / CHECKPOINT, cfg, compute, learner, env, carry, generator,
                                           total_updates)
         LOG.info("resumed from %s at update %d (%d env steps)", out / CHECKPOINT, update, update * steps_per_update)
     out.mkdir(parents=True, exist_ok=True)
+    todo = stages_to_write(out, plan, state, cfg, compute)  # before training: ``state`` still holds its update
+    stage_at = {stage["update"] for stage in plan}
     start = time.perf_counter()
     while update < total_updates:
         t0 = time.perf_counter()
@@ -189,9 +199,13 @@ def train(cfg: EfishConfig, out_dir: str | Path, progress=None, restart: bool = 
                      **episode, **losses, "env_steps_per_s": steps_per_update / seconds})
         if progress:
             progress(rows[-1], total_updates)
-        if update % t_cfg.checkpoint_every == 0 or update == total_updates:
-            save_checkpoint(out / CHECKPOINT, cfg, compute, learner, env, carry, generator, update, rows)
+        # a stage's update is always checkpointed, so a killed run resumes at or before it and never skips it
+        if update % t_cfg.checkpoint_every == 0 or update == total_updates or update in stage_at:
+            saved = save_checkpoint(out / CHECKPOINT, cfg, compute, learner, env, carry, generator, update, rows)
             write_metrics(out / METRICS, rows)
+            for stage in todo:
+                if stage["update"] == update:
+                    write_stage(out / stage_file(stage["k"]), saved, stage)
     # Written at the end, atomically: a killed job never leaves a final.pt, so the workflow reruns it and the
     # rerun resumes from checkpoint.pt; a finished run rerun with its config writes both outputs again.
     write_metrics(out / METRICS, rows)
@@ -202,6 +216,81 @@ def train(cfg: EfishConfig, out_dir: str | Path, progress=None, restart: bool = 
     return df
 
 
+def stage_updates(keep_stages, total_updates: int) -> list[int]:
+    """The update at which each fraction of ``train.keep_stages`` is kept: the first whose env steps reach that
+    fraction of the run's env steps (``total_updates`` updates: ``train.total_steps`` rounded down to whole
+    updates), ``ceil(fraction * total_updates)``; fraction 1.0 is the last update, the policy of final.pt. Close
+    fractions of a short run may share an update (their files then hold the same policy)."""
+    return [max(1, math.ceil(round(f * total_updates, 9))) for f in keep_stages]  # round: 0.3 * 10 is update 3
+
+
+def stage_plan(keep_stages, total_updates: int, steps_per_update: int) -> list[dict]:
+    """One record per stage, as a stage file stores it (key ``stage``): ``k`` (1..K in the order of the
+    fractions), ``fraction``, ``update``, ``env_steps`` (at the end of that update) and the run's
+    ``total_updates``."""
+    return [{"k": k, "fraction": float(f), "update": u, "env_steps": u * steps_per_update,
+             "total_updates": total_updates}
+            for k, (f, u) in enumerate(zip(keep_stages, stage_updates(keep_stages, total_updates), strict=True), start=1)]
+
+
+def stage_paths(out_dir: str | Path, keep_stages) -> list[Path]:
+    """``<out_dir>/stage_<k>.pt`` for k = 1..K: the files a training run with these ``train.keep_stages`` writes
+    (the last one is the final policy when its fraction is 1.0)."""
+    return [Path(out_dir) / stage_file(k) for k in range(1, len(keep_stages) + 1)]
+
+
+def stages_to_write(out: Path, plan: list[dict], state: dict | None, cfg: EfishConfig, compute: Compute
+                    ) -> list[dict]:
+    """The stages this run still has to write when it reaches their updates.
+
+    A fresh run writes every stage (over any file left in the folder). A resumed run keeps, and never rewrites,
+    each stage file it finds written at the same fraction and update under its config; one due at the
+    checkpoint's update (a run killed between its checkpoint and its stage, or a finished run rerun) is written
+    now from the checkpoint, which holds that very state; one due before the checkpoint's update that is missing
+    or from another plan (the checkpoint was written without these stages, or a longer ``total_steps`` moved the
+    stage behind it) cannot be recreated: one clear error, before any training.
+    """
+    if state is None:
+        return list(plan)
+    todo = []
+    for stage in plan:
+        path = out / stage_file(stage["k"])
+        if _stage_is_kept(path, stage, cfg, compute):
+            continue
+        if stage["update"] > state["update"]:
+            todo.append(stage)
+        elif stage["update"] == state["update"]:
+            write_stage(path, state, stage)
+        else:
+            raise ValueError(f"{path} (train.keep_stages fraction {stage['fraction']:g}, update {stage['update']}) "
+                             f"is missing or from another plan, and the checkpoint is past it at update "
+                             f"{state['update']}, so it cannot be recreated: run again with --restart to start "
+                             "afresh, or with other train.keep_stages")
+    return todo
+
+
+def _stage_is_kept(path: Path, stage: dict, cfg: EfishConfig, compute: Compute) -> bool:
+    """Whether ``path`` is this stage (fraction and update) of a run under this config."""
+    if not path.exists():
+        return False
+    try:
+        saved = torch.load(path, weights_only=False, map_location="cpu")
+        record = saved["stage"]
+        differ = _config_differences(saved, cfg, compute)
+    except Exception:  # truncated or foreign: written again when due, or one clear error when passed
+        return False
+    return (record.get("fraction"), record.get("update")) == (stage["fraction"], stage["update"]) and not differ
+
+
+def write_stage(path: Path, state: dict, stage: dict) -> None:
+    """A stage file, atomically: the checkpoint ``state`` of the stage's update (so :func:`~efish.rl.policy.
+    load_policy` reads it) with the stage's record under ``stage``."""
+    with atomic_path(path) as tmp:
+        torch.save({**state, "stage": dict(stage)}, tmp)
+    LOG.info("kept stage %d (fraction %g) at update %d (%d env steps): %s", stage["k"], stage["fraction"],
+             stage["update"], stage["env_steps"], path)
+
+
 def write_metrics(path: Path, rows: list[dict]) -> None:
     """The metrics table, one row per update, written atomically."""
     with atomic_path(path) as tmp:
@@ -209,9 +298,10 @@ def write_metrics(path: Path, rows: list[dict]) -> None:
 
 
 def save_checkpoint(path: Path, cfg: EfishConfig, compute: Compute, learner: Learner, env: VecEnv, carry: dict,
-                    generator: torch.Generator, update: int, rows: list[dict]) -> None:
+                    generator: torch.Generator, update: int, rows: list[dict]) -> dict:
     """Everything a resumed run needs to continue bit for bit, the config it ran under and the precision it
-    computed in, written atomically (tensors on the CPU, so any device can resume it)."""
+    computed in, written atomically (tensors on the CPU, so any device can resume it). Returns what it wrote
+    (CPU tensors may share memory with the live networks: use it before training goes on)."""
     state = {
         "architecture": learner.architecture, "config": training_config(cfg), "precision": compute.precision,
         "update": update, "metrics": rows,
@@ -221,8 +311,10 @@ def save_checkpoint(path: Path, cfg: EfishConfig, compute: Compute, learner: Lea
         "torch_rng": torch.get_rng_state(), "generator": generator.get_state(),
         "env": env.state_dict(), "carry": carry,
     }
+    state = _to_cpu(state)
     with atomic_path(path) as tmp:
-        torch.save(_to_cpu(state), tmp)
+        torch.save(state, tmp)
+    return state
 
 
 def _to_cpu(obj):
@@ -260,12 +352,17 @@ def _with_precision(config: dict, precision: str) -> dict:
     return {**config, "train": {**train, "precision": precision}}
 
 
+def _config_differences(state: dict, cfg: EfishConfig, compute: Compute) -> list[str]:
+    """The result-relevant keys in which a checkpoint's (or stage's) run differs from this one."""
+    recorded = _with_precision(state["config"], recorded_precision(state))
+    return config_differences(recorded, _with_precision(training_config(cfg), compute.precision),
+                              result_neutral_keys())
+
+
 def restore_checkpoint(state: dict, path: Path, cfg: EfishConfig, compute: Compute, learner: Learner, env: VecEnv,
                        carry: dict, generator: torch.Generator, total_updates: int) -> tuple[int, list[dict]]:
     """Restore a read checkpoint into live objects; one clear error if it does not fit this config."""
-    recorded = _with_precision(state["config"], recorded_precision(state))
-    differ = config_differences(recorded, _with_precision(training_config(cfg), compute.precision),
-                                result_neutral_keys())
+    differ = _config_differences(state, cfg, compute)
     if differ:
         raise ValueError(f"checkpoint {path} was written under another config ({', '.join(differ)} differ): run "
                          "again with --restart to start afresh, or use another --out")

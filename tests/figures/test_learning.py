@@ -1,0 +1,55 @@
+"""The claims along training as a figure (efish.figures.learning): one axes per part titled with its claim, part and
+trend, effect against env steps on a log axis, the paper's side named; a part without any effect says so."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from efish.analysis.claims_stages import claims_by_stage, stage_trends
+from efish.figures.learning import VERDICT_COLOURS, claims_by_stage_figure, plot_claims_by_stage
+from efish.figures.style import panel_style
+
+from ..analysis.test_claims_stages import STEPS, stage_parts
+
+PARTS = {("C3", "alignment"): (-1, [-0.1, -0.2, -0.3, -0.4]),
+         ("C10", "K off (equivalent)"): (0, [1.5, 0.9, 0.4, 0.05]),
+         ("C7", "win ratio slope, patchy4"): (+1, [np.nan] * 4)}
+
+
+@pytest.fixture
+def stacked():
+    return claims_by_stage(stage_parts(PARTS), STEPS)
+
+
+def test_every_part_has_its_axes_with_claim_part_and_trend(stacked):
+    with panel_style() as plt:
+        fig = claims_by_stage_figure(stacked, plt=plt)
+        try:
+            axes = {ax.get_title().split("\n")[0]: ax for ax in fig.axes}
+            assert list(axes) == ["C3: alignment", "C7: win ratio slope, patchy4", "C10: K off (equivalent)"]
+            c3 = axes["C3: alignment"]
+            assert c3.get_title().endswith("moving toward the paper's sign") and c3.get_xscale() == "log"
+            assert c3.get_ylabel() == "effect (paper: < 0)" and axes["C10: K off (equivalent)"].get_ylabel() == \
+                "effect (paper: 0)"
+            assert c3.get_ylim()[0] < -0.4 and c3.get_ylim()[1] > 0  # the effects and the line at 0
+            assert [t.get_text() for t in c3.get_xticklabels()] == ["25k", "50k", "75k", "100k"]
+            empty = axes["C7: win ratio slope, patchy4"]
+            assert empty.get_title().endswith("not decidable")
+            assert any("no finite effect at any stage" in t.get_text() for t in empty.texts)
+            assert [t.get_text() for t in fig.legends[0].get_texts()] == ["holds"]
+            assert "holds" in VERDICT_COLOURS
+        finally:
+            plt.close(fig)
+
+
+def test_the_figure_is_written_as_png_and_pdf(stacked, tmp_path):
+    written = plot_claims_by_stage(stacked, tmp_path / "learning" / "claims_by_stage", stage_trends(stacked))
+    assert [p.name for p in written] == ["claims_by_stage.png", "claims_by_stage.pdf"]
+    assert all(p.stat().st_size > 1000 for p in written)
+    assert sorted(p.name for p in (tmp_path / "learning").iterdir()) == ["claims_by_stage.pdf", "claims_by_stage.png"]
+
+
+def test_an_empty_table_is_refused(stacked):
+    with panel_style() as plt, pytest.raises(ValueError, match="no part to draw"):
+        claims_by_stage_figure(stacked.iloc[0:0], plt=plt)
