@@ -3,13 +3,6 @@
 # trained policy acts (the selected seed, or a recipe of config/policy/), and the job gets every one it needs.
 
 
-def assay_outputs(hidden, seed=None):
-    """The tables an assay job writes, by name (hidden: the assay records the GRU state), in top seed ``seed``'s
-    copy of the layout if given."""
-    names = [*ROLLOUT_TABLES, *(["hidden"] if hidden else [])]
-    return {t: results(assay_table("{assay}", t), seed) for t in names}
-
-
 rule assay:
     input:
         unpack(assay_policies_input),

@@ -181,6 +181,13 @@ def folder_of(name, up=0):
     return lambda wildcards, output: str(Path(output[name]).parents[up])
 
 
+def assay_outputs(hidden, seed=None):
+    """The tables an assay job writes, by name (hidden: the assay records the GRU state), in top seed ``seed``'s
+    copy of the layout if given."""
+    names = [*ROLLOUT_TABLES, *(["hidden"] if hidden else [])]
+    return {t: results(assay_table("{assay}", t), seed) for t in names}
+
+
 def analysis_inputs(analysis, seed=None):
     """The rollout tables an analysis reads, by name, for the {assay} wildcard (of top seed ``seed``)."""
     return {t: results(assay_table("{assay}", t), seed) for t in analysis.reads}
@@ -279,6 +286,22 @@ def figure_outputs(figure, run=RULE_RUN):
     """Every file a figure's job writes: each panel's PNG and PDF, then the page's."""
     panels = [run.panel(figure, p.name, ext) for p in FIGURE_PANELS[figure] for ext in FIGURE_FORMATS]
     return [str(path) for path in panels + [run.page(figure, ext) for ext in FIGURE_FORMATS]]
+
+
+def figure_legend(figure):
+    """(panel, caption, tables) of every panel of ``figure`` drawn at this scale, for the report's captions."""
+    return [(p.name, p.caption, ", ".join(f"``{path}``" for path in p.inputs.values()) or "none (a schematic)")
+            for p in FIGURE_PANELS[figure]]
+
+
+def report_entry(figure, path):
+    """A figure job's output as the report shows it: each panel's PNG under its figure's category with the
+    figure's legend, the page's PNG under "Figure pages"; PDFs are not in the report."""
+    if not path.endswith(".png"):
+        return path
+    if Path(path).parent.name == figure:
+        return report(path, caption="../report/panel.rst", category=figure, labels={"panel": Path(path).stem})
+    return report(path, caption="../report/figure_page.rst", category="Figure pages", labels={"figure": figure})
 
 
 def render_targets():

@@ -4,22 +4,6 @@
 # the figure's legend: each panel's caption and the tables it reads.
 
 
-def figure_legend(figure):
-    """(panel, caption, tables) of every panel of ``figure`` drawn at this scale, for the report's captions."""
-    return [(p.name, p.caption, ", ".join(f"``{path}``" for path in p.inputs.values()) or "none (a schematic)")
-            for p in FIGURE_PANELS[figure]]
-
-
-def report_entry(figure, path):
-    """A figure job's output as the report shows it: each panel's PNG under its figure's category with the
-    figure's legend, the page's PNG under "Figure pages"; PDFs are not in the report."""
-    if not path.endswith(".png"):
-        return path
-    if Path(path).parent.name == figure:
-        return report(path, caption="../report/panel.rst", category=figure, labels={"panel": Path(path).stem})
-    return report(path, caption="../report/figure_page.rst", category="Figure pages", labels={"figure": figure})
-
-
 for figure, panels in FIGURE_PANELS.items():
 
     rule:
