@@ -303,15 +303,18 @@ def test_a_killed_training_job_resumes_from_its_checkpoint(tmp_path):
 
 @pytest.mark.slow
 def test_the_readme_override_example_reruns_cleanly_beside_the_default_run(smoke_run):
-    """After a finished run, the override example runs in its own folder, twice, and the default stays as it was."""
+    """After a finished run, the override example runs in its own folder, twice, and the default stays as it was.
+    It asks for one assay's tables (training, selection and the assay: every kind of job an override reaches
+    before the analyses); test_a_run_override_reaches_every_drawing carries overrides on to the figures."""
     before = {p: p.stat().st_mtime_ns for p in (smoke_run / "results/smoke").glob("**/*") if p.is_file()}
+    folder = run_name("smoke", ["physics.tolerance=1e-6", "train.lr=3e-4"])
     command = ["snakemake", "--cores", "2", "--config", "scale=smoke",
                "overrides=physics.tolerance=1e-6 train.lr=3e-4", "--directory", str(smoke_run),
-               "--snakefile", str(smoke_run / "Snakefile")]
+               "--snakefile", str(smoke_run / "Snakefile"), f"results/{folder}/assays/patchy4/steps.parquet"]
     for attempt in range(2):
         result = subprocess.run(command, capture_output=True, text=True, timeout=900, env=smoke_env(smoke_run))
         assert result.returncode == 0, (attempt, result.stderr[-3000:])
-    run = smoke_run / "results" / run_name("smoke", ["physics.tolerance=1e-6", "train.lr=3e-4"])
+    run = smoke_run / "results" / folder
     assert "tolerance: 1.0e-06" in (run / "train/seed_1/config.yaml").read_text()
     assert "Nothing to be done" in result.stdout + result.stderr  # the second attempt reuses the first's outputs
     after = {p: p.stat().st_mtime_ns for p in (smoke_run / "results/smoke").glob("**/*") if p.is_file()}
