@@ -380,7 +380,7 @@ class Context:
 
 @dataclass(frozen=True)
 class Claim:
-    """A claim of CLAIMS.md: id, figure panels, the tables it reads, and its function (tables, cfg) -> its parts.
+    """A claim of the paper (README "Claims"): id, figure panels, the tables it reads, and its function (tables, cfg) -> its parts.
 
     :meth:`assess` gives the claim's row and its parts from one computation; :meth:`run` the row alone.
     """

@@ -224,7 +224,7 @@ class EnvConfig:
 # ----------------------------------------------------------------------- train
 @dataclass
 class TrainConfig:
-    """Recurrent MAPPO (SPEC 9). The sizes (hidden, epochs, num_envs, rollout_steps, chunk, total_steps) read the
+    """Recurrent MAPPO (README "Training"). The sizes (hidden, epochs, num_envs, rollout_steps, chunk, total_steps) read the
     scale by interpolation, so their one copy is in :class:`ScaleConfig` and config/scale/*.yaml; a resolved
     config (:func:`~efish.config.compose`) holds numbers."""
 
