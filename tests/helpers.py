@@ -11,13 +11,23 @@ import functools
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 from efish import Snapshot
 from efish.config import compose
 from efish.physics import Scene, build_plan
+from efish.rollout.assay import condition_configs
+from efish.rollout.conditions import conditions_table
 
 RECEPTORS = ("mormyromast", "ampullary", "knollenorgan", "knollen_size")
 BIG = 40.0  # raw action whose sigmoid / tanh is 1 to double precision
+
+
+@functools.lru_cache(maxsize=None)
+def conditions_of(assay: str, *overrides: str) -> pd.DataFrame:
+    """``assays/<assay>/conditions.parquet`` as efish assay records it at the smoke scale under ``overrides``
+    (e.g. ``env.fps=25``): every condition's resolved config. Shared: copy before editing."""
+    return conditions_table(condition_configs(["scale=smoke", *overrides, f"assay={assay}"]))
 
 
 @functools.lru_cache(maxsize=None)

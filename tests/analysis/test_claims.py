@@ -26,9 +26,10 @@ from efish.analysis.registry import run
 from efish.analysis.signalling import fit_power_law
 from efish.analysis.stats import spearman
 from efish.cli import main
+from efish.config.recorded import recorded_conditions
 from efish.layout import analysis_table, assay_table
 
-from ..helpers import cfg_with, rollout_tables
+from ..helpers import cfg_with, conditions_of, rollout_tables
 
 CFG = cfg_with("analysis.claims_resamples=40", "analysis.claims_fit_resamples=4")
 A, R = analysis_table, assay_table
@@ -252,7 +253,8 @@ def c14(flip):
                       "food_eaten": 5 + rng.normal()},
                      {"condition": f"B_alone_{pct_b}", "episode": e, "agent": 0, "size": size,
                       "food_eaten": (10 if flip else 2) + rng.normal(0, 0.3)}]
-    return {A("behaviour", "onepatch", "food_per_agent"): pd.DataFrame(rows)}
+    return {A("behaviour", "onepatch", "food_per_agent"): pd.DataFrame(rows), R("onepatch", "conditions"):
+            conditions_of("onepatch")}
 
 
 def c15(flip):
@@ -265,8 +267,9 @@ def c15(flip):
                          "n_reached": 10 - k if flip else k})
             rows.append({"condition": f"bot0.5_B0.5_rate{rate:g}_{motion}", "agent": 0, "n_episodes": 10,
                          "n_reached": 0})
-    reach = pd.DataFrame(rows)
-    return {A("onepatch", "bot", "reach_rates"): reach, A("onepatch", "bot", "reach_tests"): reach_tests(reach)}
+    reach, conditions = pd.DataFrame(rows), conditions_of("bot")
+    return {A("onepatch", "bot", "reach_rates"): reach, R("bot", "conditions"): conditions,
+            A("onepatch", "bot", "reach_tests"): reach_tests(reach, recorded_conditions(conditions))}
 
 
 def square_steps(flip: bool, episodes: int = 10, steps: int = 200) -> pd.DataFrame:

@@ -13,7 +13,7 @@ from efish.analysis.stats import STAT_COLUMNS
 from efish.config import config_dir
 from efish.rollout.schema import SCHEMAS, to_table
 
-from ..helpers import cfg_with, rollout_tables
+from ..helpers import cfg_with, conditions_of, rollout_tables
 
 #: The assays of SPEC 11 (config/assay/<name>.yaml as they land).
 SPEC_ASSAYS = {"homing", "patchy4", "uniform4", "wide2", "square2", "ablation4", "ablation1", "collective", "mute",
@@ -24,6 +24,8 @@ SPEC_ASSAYS = {"homing", "patchy4", "uniform4", "wide2", "square2", "ablation4",
 ASSAY_SPECIFIC = {("onepatch", "role_tests"): ("A_gt_B", "A_alone_75", "B_alone_25"),
                   ("onepatch", "reach_tests"): ("bot0.5_B0.5_rate0_frozen", "bot0.5_B0.5_rate1_moving"),
                   ("dynamics", "size_tests"): ("n2_K", "n4_K", "n2_noK", "n4_noK")}
+#: The assay whose recorded conditions (conditions.parquet) say who is who in those tests.
+RECORDED = {("onepatch", "role_tests"): "onepatch", ("onepatch", "reach_tests"): "bot"}
 
 
 def config_for(name: str):
@@ -38,7 +40,7 @@ def tables():
 
 def test_the_synthetic_tables_are_shaped_like_the_rollout(tables):
     for name in (*SCHEMAS, "hidden"):
-        if name != "conditions":  # no analysis reads it: the figures' fixtures write it (tests/figures/conftest.py)
+        if name != "conditions":  # synthetic tables get a recorded one per assay (helpers.conditions_of)
             to_table(tables[name], name)
 
 
@@ -47,7 +49,8 @@ def test_every_analysis_writes_its_declared_tables(name, tables):
     analysis = get(name)
     homing = {"steps": tables["steps"].query("agent < 2").replace({"condition": {"control": "electric",
                                                                                   "treated": "raycast"}})}
-    out = run(name, homing if name == "homing" else tables, config_for(name))
+    recorded = {"conditions": conditions_of("onepatch")} if "conditions" in analysis.reads else {}
+    out = run(name, homing if name == "homing" else {**tables, **recorded}, config_for(name))
     assert list(out) == list(analysis.outputs)
     for table, df in out.items():
         assert isinstance(df, pd.DataFrame) and len(df) > 0, table
@@ -55,7 +58,10 @@ def test_every_analysis_writes_its_declared_tables(name, tables):
         assert set(STAT_COLUMNS) <= set(out[table].columns), table
         if (name, table) in ASSAY_SPECIFIC:  # a test of one assay's conditions: a NaN row that says why elsewhere
             assert out[table]["reason"].astype(bool).all(), f"{name}/{table} tested conditions it does not know"
-            own = run(name, rollout_tables(conditions=ASSAY_SPECIFIC[name, table]), config_for(name))[table]
+            own = rollout_tables(conditions=ASSAY_SPECIFIC[name, table])
+            if (name, table) in RECORDED:
+                own["conditions"] = conditions_of(RECORDED[name, table])
+            own = run(name, own, config_for(name))[table]
             assert np.isfinite(own["p"]).any(), f"{name}/{table} has no finite p on its assay's conditions"
         else:
             assert np.isfinite(out[table]["p"]).any(), f"{name}/{table} has no finite p"

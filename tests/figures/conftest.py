@@ -5,20 +5,17 @@ them (``efish.analysis.registry.run``), so panels are drawn from the same table 
 
 from __future__ import annotations
 
-from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
-from tests.helpers import rollout_tables
+from tests.helpers import conditions_of, rollout_tables
 
 from efish.analysis.registry import analyses_for, run, tables_written
 from efish.analysis.selection import rank_seeds, seed_statistics, stack_top_seeds
 from efish.config import compose
 from efish.figures.panel import conditions_key
-from efish.rollout.assay import condition_configs
-from efish.rollout.conditions import conditions_table
 from efish.rollout.tables import write_tables
 
 SEEDS = 2
@@ -31,13 +28,6 @@ def _write(tables: dict[str, pd.DataFrame], folder: Path) -> None:
             write_tables({name: table}, folder)
         else:
             table.to_parquet(folder / f"{name}.parquet", index=False)
-
-
-@lru_cache(maxsize=None)
-def conditions_of(assay: str, *overrides: str) -> pd.DataFrame:
-    """``assays/<assay>/conditions.parquet`` as efish assay records it at the smoke scale under ``overrides``
-    (e.g. ``env.fps=25``): every condition's resolved config. Shared: copy before editing."""
-    return conditions_table(condition_configs(["scale=smoke", *overrides, f"assay={assay}"]))
 
 
 def _assay_tables(name: str, seed: int) -> tuple[dict, object]:

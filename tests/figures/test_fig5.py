@@ -46,19 +46,7 @@ def test_every_letter_of_spec_13_is_registered():
     assert sorted(k.split("/")[1] for k in FIG5) == list("ABCDEFGHIJKLMNOP")
 
 
-def test_roles_follow_the_onepatch_config(onepatch):
-    roles = fig5.onepatch_roles(onepatch)
-    for cond, extra in compose(["assay=onepatch"]).assay.conditions.items():
-        alone = "env.n_agents=1" in extra
-        assert len(roles[cond]) == (1 if alone else 2), cond
-    assert roles["A_lt_B"] == {"A": 0, "B": 1}
-    assert roles["B_alone_75"] == {"B": 0} and roles["A_alone_25"] == {"A": 0}
-
-
-def test_alone_controls_are_matched_by_size_as_the_analysis_matches_them(onepatch):
-    from efish.analysis.onepatch import MATCHED_ALONE
-
-    assert fig5.matched_alone(onepatch) == MATCHED_ALONE
+def test_alone_controls_sit_beside_the_class_they_are_matched_to(onepatch):
     assert fig5.class_slots("B", ["A_gt_B", "A_lt_B", "B_alone_25", "B_alone_75", "B_alone_50"], onepatch) == [
         "A_lt_B", "B_alone_75", " ", "A_gt_B", "B_alone_25", "  ", "B_alone_50"]  # an unmatched control last
 
@@ -73,8 +61,8 @@ def test_role_rows_picks_b_in_each_condition_and_rejects_bad_roles(onepatch):
         fig5.role_rows(table, "C", onepatch)
 
 
-def test_bot_conditions_read_size_rate_and_mobility_from_the_config(recorded):
-    bots = fig5.bot_conditions(assay_conditions(recorded("bot"), "bot")).set_index("condition")
+def test_bot_classes_read_size_rate_and_mobility_from_the_config(recorded):
+    bots = fig5.bot_classes(assay_conditions(recorded("bot"), "bot")).set_index("condition")
     assert len(bots) == 30 and set(bots["agent"]) == {1}
     row = bots.loc["bot0.25_B0.75_rate0.5_frozen"]
     assert (row["size_class"], row["bot_eod_rate"], row["mobility"]) == ("A_lt_B", 0.5, "frozen")

@@ -29,6 +29,7 @@ import numpy as np
 import pandas as pd
 from scipy import stats as sps
 
+from ..config.recorded import recorded_conditions
 from ..config.schema import AssayConfig, EfishConfig
 from ..io import read_parquet
 from ..layout import analysis_table, assay_table
@@ -65,7 +66,7 @@ from .dynamics import DECODE_TARGETS, plsc
 from .dynamics_tests import groupsize_parts, smaller_larger
 from .homing import error_angles
 from .interactions import bite_rate_by_class
-from .onepatch import REACH_CONTRASTS, SOCIAL, bot_reach_counts, roles
+from .onepatch import REACH_CONTRASTS, Configs, bot_reach_counts, matched_alone, roles, social_conditions
 from .registry import ANALYSES, tables_written
 from .signalling import EVENTS, fit_power_law, peri_event_rate
 from .stats import spearman
@@ -305,23 +306,37 @@ def c9(ctx: Context) -> list[Part]:
 
 # --------------------------------------------------------------- Fig 5
 ONEPATCH_FOOD = analysis_table("behaviour", "onepatch", "food_per_agent")
+ONEPATCH_CONDITIONS = assay_table("onepatch", "conditions")
+
+
+def _recorded(ctx: Context, conditions: str) -> Configs:
+    """The conditions the assay recorded (who is A, B, the bot or alone, and their sizes)."""
+    return recorded_conditions(ctx.table(conditions), conditions)
 
 
 @claim("C14", "5E-H", "intruder B eats more with A present than alone; A is unaffected; B does better when larger",
-       [ONEPATCH_FOOD])
+       [ONEPATCH_FOOD, ONEPATCH_CONDITIONS])
 def c14(ctx: Context) -> list[Part]:
-    def people() -> pd.DataFrame:
-        """Agent-episodes with role (A, B), setting (a social condition or alone) and the size class they match."""
-        return roles(ctx.table(ONEPATCH_FOOD))
+    configs = _recorded(ctx, ONEPATCH_CONDITIONS)
+    matched = matched_alone(configs)
 
-    def b_social(size_class: str) -> Outcome:
-        """B with A in ``size_class`` vs B alone at the same size (the matched alone condition)."""
-        b = people().query("role == 'B' and size_class == @size_class")
-        return mann_whitney_part(ctx, b, "food_eaten", "setting", size_class, "alone", +1)
+    def people() -> pd.DataFrame:
+        """Agent-episodes with role (A, B) and setting (a social condition or alone)."""
+        return roles(ctx.table(ONEPATCH_FOOD), configs)
+
+    def b_social(social: str) -> Outcome:
+        """B with A in ``social`` vs B alone at the same size (the matched alone condition)."""
+        if ("B", social) not in matched:
+            raise ValueError(f"no B alone condition at B's size in {social}")
+        b = people()
+        b = b[(b["role"] == "B") & b["condition"].isin([social, matched["B", social]])]
+        return mann_whitney_part(ctx, b, "food_eaten", "setting", social, "alone", +1)
 
     def a_unaffected() -> Outcome:
         """A with B (every size class) vs A alone at the same sizes: the two samples have one size mix."""
-        a = people().query("role == 'A'")
+        controls = [alone for (role, _), alone in matched.items() if role == "A"]
+        a = people()
+        a = a[(a["role"] == "A") & ((a["setting"] != "alone") | a["condition"].isin(controls))]
         a = a.assign(setting=np.where(a["setting"] == "alone", "alone", "social"))
         return unpaired_equivalence(ctx, a, "food_eaten", "setting", "social", "alone")
 
@@ -329,7 +344,8 @@ def c14(ctx: Context) -> list[Part]:
         b = people().query("role == 'B' and setting != 'alone'")
         return spearman_part(ctx, b, "size", "food_eaten", +1)
     stat = "median food of B with A ({}) minus B alone at B's size; Mann-Whitney"
-    return ([ctx.part(f"B social, {c}", stat.format(c), functools.partial(b_social, c)) for c in SOCIAL]
+    return ([ctx.part(f"B social, {c}", stat.format(c), functools.partial(b_social, c))
+             for c in social_conditions(configs)]
             + [ctx.part("A social vs alone (equivalent)", "median food of A with B minus A alone at A's sizes "
                         "(size classes pooled, one alone condition per class); Mann-Whitney and TOST", a_unaffected),
                ctx.part("B food vs B size", "Spearman rho of B's food against B's size over the social conditions",
@@ -338,13 +354,14 @@ def c14(ctx: Context) -> list[Part]:
 
 BOT_REACH = analysis_table("onepatch", "bot", "reach_rates")
 BOT_REACH_TESTS = analysis_table("onepatch", "bot", "reach_tests")
+BOT_CONDITIONS = assay_table("bot", "conditions")
 
 
 def _reach(ctx: Context, contrast: str) -> Outcome:
     """The onepatch analysis's Fisher row of B's reach rate (pooled episodes); interval over episodes."""
     row = stat_row(ctx.table(BOT_REACH_TESTS), contrast=contrast)
     a, b = REACH_CONTRASTS[contrast]
-    counts = bot_reach_counts(ctx.table(BOT_REACH), contrast)
+    counts = bot_reach_counts(ctx.table(BOT_REACH), _recorded(ctx, BOT_CONDITIONS), contrast)
     present(counts.reset_index(), "group", [a, b], "bot episodes")
     # one row per episode (reached or not): the reach table's counts, resampled as episodes
     per = pd.DataFrame([{"condition": g, "episode": i, "reached": i < k}
@@ -354,7 +371,7 @@ def _reach(ctx: Context, contrast: str) -> Outcome:
 
 
 @claim("C15", "5I,J", "B reaches the patch more often when the bot is frozen, and when it emits than when silent",
-       [BOT_REACH, BOT_REACH_TESTS])
+       [BOT_REACH, BOT_REACH_TESTS, BOT_CONDITIONS])
 def c15(ctx: Context) -> list[Part]:
     return [ctx.part("frozen vs moving bot", "B's reach rate with the bot frozen minus moving; Fisher exact "
                      "(onepatch reach_tests)", functools.partial(_reach, ctx, "mobility")),

@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from ..config.recorded import recorded_conditions
 from ..config.schema import AssayConfig, EfishConfig
 from ..io import read_parquet
 from ..layout import ROLLOUT_TABLES
@@ -207,12 +208,14 @@ def _homing(t: Tables, cfg: EfishConfig) -> Tables:
 
 # --------------------------------------------------------------- onepatch
 def _onepatch(t: Tables, cfg: EfishConfig) -> Tables:
-    """Cumulative food over time, reach rates of the arena's central patch, and the tests by role (Fig 5E-J)."""
+    """Cumulative food over time, reach rates of the arena's central patch, and the tests by role (Fig 5E-J); who
+    is A, B, the bot or alone comes from the conditions the run recorded."""
     steps, arena = t["steps"], cfg.arena
     centre = (arena.width_cm / 2, arena.height_cm / 2)
     reach = reach_rates(steps, centre, arena.onepatch_radius_cm)
+    configs = recorded_conditions(t["conditions"], "the assay's conditions table")
     return {"food_time_course": food_time_course(steps), "reach_rates": reach,
-            "role_tests": role_tests(food_from_steps(steps)), "reach_tests": reach_tests(reach)}
+            "role_tests": role_tests(food_from_steps(steps), configs), "reach_tests": reach_tests(reach, configs)}
 
 
 # --------------------------------------------------------------- dynamics
@@ -259,7 +262,7 @@ ANALYSES: dict[str, Analysis] = {a.name: a for a in [
              ("size_tests",)),
     Analysis("homing", _homing, ("steps",), ("homing",),
              ("error_histogram", "error_vs_time", "trajectory_shape", "perception"), ("perception",)),
-    Analysis("onepatch", _onepatch, ("steps",), ("onepatch", "bot"),
+    Analysis("onepatch", _onepatch, ("steps", "conditions"), ("onepatch", "bot"),
              ("food_time_course", "reach_rates", "role_tests", "reach_tests"), ("role_tests", "reach_tests")),
     Analysis("dynamics", _dynamics, ("hidden", "steps"), ("patchy4", "wide2", "homing", "groupsize", "square2"),
              ("dimensionality", "subsampling", "decoding", "food_decoding", "plsc", "condition_tests", "size_tests",

@@ -16,12 +16,13 @@ matched to; in the bot assay the bot plays A (it sits at the patch), so
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 
 import numpy as np
 import pandas as pd
 
 from .. import layout
+from ..analysis.onepatch import ROLE_LETTERS, Configs, bot_conditions, matched_alone, onepatch_roles
 from ..config.schema import EfishConfig
 from .panel import Panel
 from .style import (
@@ -39,12 +40,8 @@ from .style import (
 )
 
 Tables = dict[str, pd.DataFrame]
-#: Condition -> its recorded config, in the assay's order (:func:`~efish.figures.style.assay_conditions`).
-Configs = Mapping[str, EfishConfig]
 ONEPATCH, BOT, PAIRS = "onepatch", "bot", "square2"
 
-#: The one-patch roles (``env.roles``) and the letter each has in the paper.
-ROLE_LETTERS = {"resident": "A", "intruder": "B"}
 _ROLE_NAMES = {letter: role for role, letter in ROLE_LETTERS.items()}
 #: Short labels of the one-patch conditions (config/assay/onepatch.yaml) where no recorded config says more
 #: (captions); an unknown name is shown as is. On a panel, :func:`class_label` reads the label off the recorded
@@ -64,30 +61,6 @@ DARK_GREY = "#404040"
 
 
 # ------------------------------------------------------------------ configs
-def onepatch_roles(configs: Configs) -> dict[str, dict[str, int]]:
-    """Per one-patch condition: role letter ("A", "B") -> agent index, from each condition's ``env.roles``
-    (``configs``: the one-patch conditions the run recorded)."""
-    return {cond: {ROLE_LETTERS[r]: i for i, r in enumerate(cfg.env.roles) if r in ROLE_LETTERS}
-            for cond, cfg in configs.items()}
-
-
-def matched_alone(configs: Configs) -> dict[tuple[str, str], str]:
-    """(role letter, social condition) -> the one-patch alone condition whose lone agent has that role and the size
-    the role has in the social condition (from each recorded condition's ``env.roles`` and ``env.sizes``)."""
-    roles = onepatch_roles(configs)
-    alone = {cond: (letter, configs[cond].env.sizes) for cond, r in roles.items() if len(r) == 1 for letter in r}
-    out = {}
-    for cond, r in roles.items():
-        sizes = configs[cond].env.sizes
-        if len(r) < 2 or not sizes:
-            continue
-        for letter, agent in r.items():
-            for a, (lone, s) in alone.items():
-                if lone == letter and len(s) == 1 and np.isclose(s[0], sizes[agent]):
-                    out[letter, cond] = a
-    return out
-
-
 def role_rows(table: pd.DataFrame, role: str, configs: Configs) -> pd.DataFrame:
     """The rows of ``table`` (with condition and agent columns) that belong to ``role`` ("A" or "B").
 
@@ -103,19 +76,13 @@ def role_rows(table: pd.DataFrame, role: str, configs: Configs) -> pd.DataFrame:
     return out
 
 
-def bot_conditions(configs: Configs) -> pd.DataFrame:
-    """One row per bot condition (``configs``: the bot assay's recorded conditions): the trained agent, the size
-    class (bot vs B), bot EOD rate, frozen or moving."""
-    rows = []
-    for cond, cfg in configs.items():
-        bot = cfg.env.bots[0]
-        agent = next(i for i in range(cfg.env.n_agents) if i not in cfg.env.bots)
-        s_bot, s_agent = cfg.env.sizes[bot], cfg.env.sizes[agent]
-        relation = "<" if s_bot < s_agent else "=" if s_bot == s_agent else ">"
-        rows.append({"condition": cond, "agent": agent, "size_class": BOT_CLASSES[relation],
-                     "class_label": f"bot{relation}B", "bot_eod_rate": cfg.env.bot_eod_rate,
-                     "mobility": "frozen" if bot in cfg.env.frozen else "moving"})
-    return pd.DataFrame(rows)
+def bot_classes(configs: Configs) -> pd.DataFrame:
+    """The bot conditions (:func:`efish.analysis.onepatch.bot_conditions`) with the ``size_class`` whose colour
+    each takes (bot vs B as A vs B) and its ``class_label``."""
+    bots = bot_conditions(configs)
+    relation = np.select([np.isclose(bots["bot_size"], bots["agent_size"]), bots["bot_size"] < bots["agent_size"]],
+                         ["=", "<"], ">")
+    return bots.assign(size_class=[BOT_CLASSES[r] for r in relation], class_label=[f"bot{r}B" for r in relation])
 
 
 # ------------------------------------------------------------------ helpers
@@ -404,7 +371,7 @@ def bot_reach(contrast: str) -> Callable[[Tables, object], None]:
         rates = _usable(ax, tables["reach"], "reach_rate", "bot reach_rates")
         if rates is None:
             return
-        rows = rates.merge(bot_conditions(assay_conditions(tables, BOT)), on=["condition", "agent"])  # B only
+        rows = rates.merge(bot_classes(assay_conditions(tables, BOT)), on=["condition", "agent"])  # B only
         if rows.empty:
             missing(ax, "no reach rate of the trained agent in the bot table")
             return

@@ -44,7 +44,7 @@ def tint(colour: str, amount: float = 0.5) -> str:
 
 #: The one-patch size classes, and each size-matched alone control (config/assay/onepatch.yaml) in a light tint of
 #: the class it is the control of: A alone at 0.75 and B alone at 0.25 go with A>B, both at 0.5 with A=B, A alone
-#: at 0.25 and B alone at 0.75 with A<B (efish.analysis.onepatch.MATCHED_ALONE).
+#: at 0.25 and B alone at 0.75 with A<B (efish.analysis.onepatch.matched_alone).
 _S = _ONEPATCH_SOCIAL
 ONEPATCH_CLASS_COLOURS = {**_S,
                           "A_alone_75": tint(_S["A_gt_B"]), "A_alone_50": tint(_S["A_eq_B"]),
