@@ -19,6 +19,7 @@ include: "workflow/rules/scenes.smk"
 include: "workflow/rules/figures.smk"
 include: "workflow/rules/render.smk"
 include: "workflow/rules/claims.smk"
+include: "workflow/rules/learning.smk"
 
 
 rule all:

@@ -145,6 +145,30 @@ def test_efish_claims_by_stage_writes_the_stacked_table_the_trends_and_the_figur
     assert text.startswith("C3 (alignment): moving toward the paper's sign") and "claims_by_stage.png" in text
 
 
+def test_efish_claims_by_stage_reads_env_steps_from_the_stage_files_and_writes_the_claims_page(tmp_path):
+    """--stage-policies: each stage file's record gives its env steps; --claims: claims.md beside the tables is the
+    final policy's claims with one line per claim along training."""
+    import torch
+
+    args = stage_args(tmp_path)
+    policies = []
+    for k, n in STEPS.items():
+        torch.save({"stage": {"k": k, "fraction": k / 4, "update": k, "env_steps": n, "total_updates": 4}},
+                   tmp_path / f"stage_{k}.pt")
+        policies.append(f"{k}={tmp_path / f'stage_{k}.pt'}")
+    claims_rows({"C3": "weaker", "C9": "holds"}).to_parquet(tmp_path / "claims.parquet")
+    out = tmp_path / "learning"
+    assert main(["claims-by-stage", "scale=smoke", *args[:args.index("--env-steps")], "--stage-policies", *policies,
+                 "--claims", str(tmp_path / "claims.parquet"), "--out", str(out),
+                 "--figures", str(tmp_path / "figures")]) == 0
+    stacked = pd.read_parquet(out / "claims_by_stage.parquet")
+    assert stacked.groupby("stage")["env_steps"].first().to_dict() == STEPS
+    page = (out / "claims.md").read_text()
+    assert "\n## Along training\n" in page and "- C3 (alignment): moving toward the paper's sign" in page
+    with pytest.raises(SystemExit):  # one or the other
+        main(["claims-by-stage", "scale=smoke", *args, "--stage-policies", *policies])
+
+
 @pytest.mark.parametrize("change, message", [
     (lambda a: ["1=x" if x == "1=25000" else x for x in a], "--env-steps 1=x: N must be a whole number"),
     (lambda a: [x for x in a if x != "4=100000"], "no env steps for stages [4]"),

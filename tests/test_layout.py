@@ -47,6 +47,10 @@ def test_a_run_and_its_top_seeds_share_one_layout():
     assert run.panel("fig3", "K", "png") == Path("figures/laptop/fig3/K.png")
     assert Run("{run}").top_seed("{seed}").path("claims/claims.parquet") == Path(
         "results/{run}/seeds/seed_{seed}/claims/claims.parquet")
+    stage = run.stage(2)  # a training stage's copy: the selected seed's stage_2.pt acting
+    assert stage.path(assay_table("wide2", "steps")) == Path("results/laptop/learning/stage_2/assays/wide2/steps.parquet")
+    assert stage.log("claims") == Path("results/laptop/logs/learning/stage_2/claims.log")
+    assert stage.within(None) == run and stage.figures == run.figures
 
 
 def path_patterns(path: Path) -> list[str]:

@@ -65,6 +65,7 @@ from .layout import (
     CLAIMS_PAGE,
     CLAIMS_TABLE,
     CLAIMS_TRENDS,
+    CLAIMS_TRENDS_PAGE,
     CONTACT_SHEET,
     RANKING,
     SELECTED_SEED,
@@ -171,8 +172,14 @@ def _parser() -> argparse.ArgumentParser:
     cbs.add_argument("--stages", nargs="+", required=True, metavar="K=PATH",
                      help="each stage's claim_parts.parquet, its claims folder, or its results folder "
                           "(results/{run}/learning/stage_<k>)")
-    cbs.add_argument("--env-steps", nargs="+", required=True, metavar="K=N",
-                     help="the env steps trained at each stage (one per --stages entry)")
+    trained = cbs.add_mutually_exclusive_group(required=True)
+    trained.add_argument("--env-steps", nargs="+", metavar="K=N",
+                         help="the env steps trained at each stage (one per --stages entry)")
+    trained.add_argument("--stage-policies", nargs="+", metavar="K=PATH",
+                         help="the stage file (train/seed_N/stage_<k>.pt) each stage's assays acted with: its "
+                              "record gives the env steps trained")
+    cbs.add_argument("--claims", type=Path, help="the run's claims.parquet (its final policy's verdicts): writes "
+                                                 "claims.md beside the tables with one line per claim along training")
     cbs.add_argument("--episodes", nargs="+", metavar="K=N",
                      help="episodes per condition the stage's assays ran (adds an episodes column)")
     cbs.add_argument("--out", type=Path, help="folder for claims_by_stage.parquet and claims_trends.parquet "
@@ -475,6 +482,14 @@ def _stage_counts(items: Sequence[str] | None, flag: str) -> dict[int, int]:
     return {k: int(v) for k, v in counts.items()}
 
 
+def _stage_env_steps(items: Sequence[str]) -> dict[int, int]:
+    """``--stage-policies``: the env steps each stage file records (train.keep_stages)."""
+    from .rl.policy import read_stage
+
+    return {k: int(read_stage(path)["env_steps"])
+            for k, path in _keyed(items, "--stage-policies", "K", "PATH", "1=results/study/train/seed_3/stage_1.pt").items()}
+
+
 def _read_stage(k: int, where: Path):
     """(path, table) of stage ``k``'s parts table, from its claim_parts.parquet, its claims folder or its results
     folder."""
@@ -489,20 +504,29 @@ def _read_stage(k: int, where: Path):
 
 
 def _claims_by_stage(args, cfg, started) -> None:
+    from .analysis.claims_report import claims_markdown
     from .analysis.claims_stages import claims_by_stage, stage_trends, trend_lines
     from .figures.learning import plot_claims_by_stage
-    from .io import write_parquet_tables
+    from .io import read_parquet, write_parquet_tables, write_text_atomic
 
     run = _run(cfg, args.overrides)
     out = args.out or run.path(CLAIMS_BY_STAGE).parent
     figures = args.figures or (run.figures / CLAIMS_BY_STAGE_FIGURE).parent
     read = {k: _read_stage(k, Path(p)) for k, p in _keyed(args.stages, "--stages", "K", "PATH",
                                                            "1=results/laptop/learning/stage_1").items()}
-    env_steps, episodes = _stage_counts(args.env_steps, "--env-steps"), _stage_counts(args.episodes, "--episodes")
+    env_steps = (_stage_counts(args.env_steps, "--env-steps") if args.env_steps is not None
+                 else _stage_env_steps(args.stage_policies))
+    episodes = _stage_counts(args.episodes, "--episodes")
+    final = read_parquet(args.claims, "the run's claims table") if args.claims is not None else None
     stacked = claims_by_stage({k: table for k, (_, table) in read.items()}, env_steps, episodes or None)
     trends = stage_trends(stacked, cfg.analysis.claims_trend_alpha)
     drawn = plot_claims_by_stage(stacked, figures / Path(CLAIMS_BY_STAGE_FIGURE).name, trends)
     tables = write_parquet_tables({Path(CLAIMS_BY_STAGE).stem: stacked, Path(CLAIMS_TRENDS).stem: trends}, out)
+    if final is not None:
+        header = (f"Claims of the paper at scale {cfg.scale.name} (run {run.name}), the selected seed's final policy, "
+                  f"with each claim's trend over {len(env_steps)} training stages, {started.strftime('%Y-%m-%d %H:%M UTC')}")
+        tables.append(out / Path(CLAIMS_TRENDS_PAGE).name)
+        write_text_atomic(tables[-1], claims_markdown(final, header, trend_lines(trends)))
     inputs = {"stages": {str(k): str(path) for k, (path, _) in read.items()},
               "env_steps": {str(k): n for k, n in env_steps.items()},
               "episodes": {str(k): n for k, n in episodes.items()}}

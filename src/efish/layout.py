@@ -4,13 +4,15 @@ A run named ``<run>`` (the scale, or the scale and a hash of its overrides) keep
 its tables under ``results/<run>/`` and its drawings under ``figures/<run>/``::
 
     results/<run>/
-      train/<seed_N | policy>/        final.pt, metrics.parquet (training)
+      train/<seed_N | policy>/        final.pt, metrics.parquet, stage_K.pt (training)
       selection/seed_N/               episodes, steps, food (held-out patchy episodes)
       analysis/selection/             ranking.parquet, selected_seed.txt
       assays/<assay>/                 steps, episodes, food, conditions (, hidden) .parquet
       analysis/<analysis>/<assay>/    the tables of efish.analysis.registry
       seeds/<assay>/episodes.parquet  the top seeds' episodes stacked (supplement)
       seeds/seed_N/                   another top seed's assays, analyses and claims, same layout
+      learning/stage_K/               the same for the selected seed's K-th kept training stage
+      learning/                       claims_by_stage, claims_trends .parquet, claims.md (claims along training)
       scenes/<scene>.parquet          field maps
       claims/                         claims.parquet, claims.md
       bench/                          benchmark tables
@@ -43,6 +45,7 @@ FIGURE_FORMATS = ("png", "pdf")
 BENCH = "bench"  # the benchmarks' folder: tables under results/<run>/, figures under figures/<run>/
 BENCHMARKS = "benchmarks"  # Snakemake's per-job .tsv timings under results/<run>/
 CONTACT_SHEET = "contact_sheet.png"  # under figures/<run>/
+LEARNING = "learning"  # the claims along training: the stages' copies of the layout and the stacked tables
 
 
 def seed_name(seed: int | str) -> str:
@@ -131,38 +134,57 @@ def parse_table(path: str) -> TableId | None:
     return None
 
 
+def top_seed_copy(seed: int | str) -> str:
+    """``seeds/seed_N``: another top seed's copy of the layout (its assays, analyses and claims)."""
+    return f"seeds/{seed_name(seed)}"
+
+
+def stage_copy(k: int | str) -> str:
+    """``learning/stage_K``: the copy of the layout where the selected seed's K-th kept training stage acts."""
+    return f"{LEARNING}/{stage_name(k)}"
+
+
 @dataclass(frozen=True)
 class Run:
-    """The folders of one run. ``name`` may be a Snakemake wildcard (``{run}``); ``seed`` set means another top
-    seed's copy of the layout (``results/<run>/seeds/seed_N/``), whose logs and benchmark files stay under the
-    run's own ``logs/seeds/seed_N/`` and ``benchmarks/seeds/seed_N/`` so one folder times the whole run."""
+    """The folders of one run. ``name`` may be a Snakemake wildcard (``{run}``); ``copy`` set means a copy of the
+    layout inside the run: another top seed's (:func:`top_seed_copy`, ``results/<run>/seeds/seed_N/``) or a
+    training stage's (:func:`stage_copy`, ``results/<run>/learning/stage_K/``). A copy's logs and benchmark files
+    stay under the run's own ``logs/<copy>/`` and ``benchmarks/<copy>/`` so one folder times the whole run."""
 
     name: str
-    seed: int | str | None = None
+    copy: str = ""
     results_root: Path = RESULTS_ROOT
     figures_root: Path = FIGURES_ROOT
 
     @property
     def results(self) -> Path:
-        """Where this run's (or this top seed's) tables live."""
+        """Where this run's (or this copy's) tables live."""
         root = Path(self.results_root) / self.name
-        return root if self.seed is None else root / "seeds" / seed_name(self.seed)
+        return root / self.copy if self.copy else root
 
     @property
     def figures(self) -> Path:
         return Path(self.figures_root) / self.name
 
+    def within(self, copy: str | None) -> Run:
+        """The copy of the layout at ``copy`` (a :func:`top_seed_copy` or :func:`stage_copy`; None: the run)."""
+        return Run(self.name, copy or "", self.results_root, self.figures_root)
+
     def top_seed(self, seed: int | str) -> Run:
         """Another top seed's copy of the layout."""
-        return Run(self.name, seed, self.results_root, self.figures_root)
+        return self.within(top_seed_copy(seed))
+
+    def stage(self, k: int | str) -> Run:
+        """The copy of the layout of the selected seed's k-th kept training stage."""
+        return self.within(stage_copy(k))
 
     def path(self, relative: str) -> Path:
         """A file under the results folder, from a relative name of this module (e.g. :func:`assay_table`)."""
         return self.results / relative
 
     def _job_file(self, kind: str, job: str, suffix: str) -> Path:
-        seed = "" if self.seed is None else f"seeds/{seed_name(self.seed)}/"
-        return Path(self.results_root) / self.name / kind / f"{seed}{job}{suffix}"
+        copy = f"{self.copy}/" if self.copy else ""
+        return Path(self.results_root) / self.name / kind / f"{copy}{job}{suffix}"
 
     def log(self, job: str) -> Path:
         """``results/<run>/logs/<job>.log`` (``job`` may hold folders: ``assays/patchy4``)."""
@@ -210,6 +232,8 @@ class Run:
 CLAIM_PARTS = "claims/claim_parts.parquet"  # one row per part of each claim, beside claims.parquet
 #: The claims along training (``efish claims-by-stage``): the stages' parts stacked and each part's trend, under
 #: ``results/<run>/``, and their figure (``.png``, ``.pdf``) under ``figures/<run>/``.
-CLAIMS_BY_STAGE = "learning/claims_by_stage.parquet"
-CLAIMS_TRENDS = "learning/claims_trends.parquet"
-CLAIMS_BY_STAGE_FIGURE = "learning/claims_by_stage"
+CLAIMS_BY_STAGE = f"{LEARNING}/claims_by_stage.parquet"
+CLAIMS_TRENDS = f"{LEARNING}/claims_trends.parquet"
+#: The selected seed's claims page with one line per claim along training (its trend over the stages).
+CLAIMS_TRENDS_PAGE = f"{LEARNING}/claims.md"
+CLAIMS_BY_STAGE_FIGURE = f"{LEARNING}/claims_by_stage"

@@ -256,3 +256,14 @@ def test_bad_keep_stages_are_one_line_errors(value):
         compose(TINY + [f"train.keep_stages={value}"])
     assert str(info.value).startswith("train.keep_stages=") and "\n" not in str(info.value)
     assert "strictly increasing fractions in (0, 1]" in str(info.value)
+
+
+def test_the_scale_sets_the_stages_and_learning_needs_them():
+    """scale.keep_stages reaches train.keep_stages (every seed keeps them); scale.learning without stages is one
+    line naming both keys."""
+    from efish.config import ConfigError
+
+    assert compose(["scale=smoke"]).train.keep_stages == [0.5, 1.0]
+    assert compose(["scale=laptop", "scale.keep_stages=[0.5,1.0]"]).train.keep_stages == [0.5, 1.0]
+    with pytest.raises(ConfigError, match=r"^scale.learning=true needs scale.keep_stages"):
+        compose(["scale=laptop", "scale.learning=true"])

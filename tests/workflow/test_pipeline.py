@@ -378,3 +378,38 @@ def test_a_run_override_reaches_every_drawing(smoke_run, tmp_path):
     configs = assay_conditions(load_tables(PANELS["fig5/E"], run, seeds=2), "onepatch")
     assert configs["A_lt_B"].env.sizes == [0.5, 0.75] and configs["A_lt_B"].env.fps == 50
     assert matched_alone(configs)["A", "A_lt_B"] == "A_alone_50"  # the files here would say A_alone_25
+
+
+@pytest.mark.slow
+def test_the_learning_target_runs_the_claims_at_each_kept_stage(smoke_run, tmp_path):
+    """`snakemake learning` at smoke scale (scale.keep_stages [0.5, 1.0]): the selected seed's stage_1.pt acts in
+    every claim's assay in learning/stage_1/ (at most scale.stage_episodes episodes per condition), its analyses
+    and claims follow, and the last stage (fraction 1) is the run's own claims; claims_by_stage stacks both. The
+    smoke run's results are copied with their times so that only the stage's jobs run."""
+    from ..helpers import scratch_workflow
+
+    work = scratch_workflow(tmp_path / "work")
+    shutil.copytree(smoke_run / "results/smoke", work / "results/smoke")
+    selected = int((work / "results/smoke/analysis/selection/selected_seed.txt").read_text())
+    command = ["snakemake", "--cores", "2", "--config", "scale=smoke", "--rerun-triggers", "mtime", "--printshellcmds",
+               "--directory", str(work), "--snakefile", str(work / "Snakefile"), "learning"]
+    result = subprocess.run(command, capture_output=True, text=True, timeout=1200, env=smoke_env(work))
+    assert result.returncode == 0, result.stderr[-3000:]
+    log = result.stdout + result.stderr
+    assert "rule train:" not in log and "rule assay:" not in log and "rule claims:" not in log  # the run's own
+    assert f"--policy selected=results/smoke/train/seed_{selected}/stage_1.pt" in log
+    assert "scale.max_episodes=2" in log
+
+    learning = work / "results/smoke/learning"
+    stage = pd.read_parquet(learning / "stage_1/assays/patchy4/conditions.parquet")
+    assert (stage["episodes"] <= 2).all()
+    stacked = pd.read_parquet(learning / "claims_by_stage.parquet")
+    steps = stacked.groupby("stage")["env_steps"].first()
+    assert list(steps.index) == [1, 2] and steps.is_monotonic_increasing
+    own = pd.read_parquet(work / "results/smoke/claims/claim_parts.parquet")
+    last = stacked[stacked["stage"] == 2]
+    assert len(last) == len(own) and set(last["claim"]) == set(own["claim"])
+    assert set(pd.read_parquet(learning / "claims_trends.parquet")["claim"]) <= set(stacked["claim"])
+    assert "Along training" in (learning / "claims.md").read_text()
+    for ext in ("png", "pdf"):
+        assert (work / f"figures/smoke/learning/claims_by_stage.{ext}").stat().st_size > 0

@@ -2,24 +2,26 @@
 # registry declares (efish.layout.analysis_table). The DAG asks for the analyses of each assay of the scale whose
 # input tables that assay writes (common.smk: ASSAY_ANALYSES). The same rule per analysis, named
 # top_seed_analysis_<analysis>, runs on a top seed's rerun assays in its copy of the layout (the analyses the
-# claims read there; common.smk: seed_analysis_assays).
+# claims read there; common.smk: seed_analysis_assays), and stage_analysis_<analysis> on a training stage's
+# (learning.smk).
 
 
 for analysis in ANALYSES.values():
-    variants = [(None, "", analysis.assays), ("{seed}", "top_seed_", seed_analysis_assays(analysis))]
-    for seed, prefix, assays in (v for v in variants if v[2]):
+    variants = [(None, "", analysis.assays), (TOP_SEED, "top_seed_", seed_analysis_assays(analysis)),
+                (STAGE, "stage_", seed_analysis_assays(analysis) if STAGES else [])]
+    for copy, prefix, assays in (v for v in variants if v[2]):
 
         rule:
             name:
                 f"{prefix}analysis_{analysis.name}"
             input:
-                **analysis_inputs(analysis, seed),
+                **analysis_inputs(analysis, copy),
             output:
-                **analysis_outputs(analysis, seed=seed),
+                **analysis_outputs(analysis, copy=copy),
             log:
-                log(f"analysis/{analysis.name}/{{assay}}", seed),
+                log(f"analysis/{analysis.name}/{{assay}}", copy),
             benchmark:
-                benchmark(f"analysis/{analysis.name}/{{assay}}", seed)
+                benchmark(f"analysis/{analysis.name}/{{assay}}", copy)
             params:
                 overrides=ARGS,
                 analysis=analysis.name,

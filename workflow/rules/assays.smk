@@ -38,18 +38,18 @@ use rule assay as assay_with_hidden with:
 # rules, whose inputs (assay_policies_input) read {seed}.
 use rule assay as top_seed_assay with:
     output:
-        **assay_outputs(hidden=False, seed="{seed}"),
+        **assay_outputs(hidden=False, copy=TOP_SEED),
     log:
-        log("assays/{assay}", seed="{seed}"),
+        log("assays/{assay}", TOP_SEED),
     benchmark:
-        benchmark("assays/{assay}", seed="{seed}")
+        benchmark("assays/{assay}", TOP_SEED)
     wildcard_constraints:
         assay="|".join(a for a in TOP_SEED_ASSAYS if a not in TOP_SEED_HIDDEN) or "^$",
 
 
 use rule top_seed_assay as top_seed_assay_with_hidden with:
     output:
-        **assay_outputs(hidden=True, seed="{seed}"),
+        **assay_outputs(hidden=True, copy=TOP_SEED),
     wildcard_constraints:
         assay="|".join(TOP_SEED_HIDDEN) or "^$",
 

@@ -34,13 +34,13 @@ use rule claims as top_seed_claims with:
     input:
         tables=claims_inputs,
     output:
-        table=results(CLAIMS_TABLE, "{seed}"),
-        parts=results(CLAIM_PARTS, "{seed}"),
-        page=results(CLAIMS_PAGE, "{seed}"),
+        table=results(CLAIMS_TABLE, TOP_SEED),
+        parts=results(CLAIM_PARTS, TOP_SEED),
+        page=results(CLAIMS_PAGE, TOP_SEED),
     log:
-        log("claims", "{seed}"),
+        log("claims", TOP_SEED),
     benchmark:
-        benchmark("claims", "{seed}")
+        benchmark("claims", TOP_SEED)
     params:
         overrides=ARGS,
         results=folder_of("table", 1),

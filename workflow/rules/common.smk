@@ -18,8 +18,12 @@ from efish.figures.registry import PANELS, drawable
 from efish.figures.render import input_paths
 from efish.layout import (
     CLAIM_PARTS,
+    CLAIMS_BY_STAGE,
+    CLAIMS_BY_STAGE_FIGURE,
     CLAIMS_PAGE,
     CLAIMS_TABLE,
+    CLAIMS_TRENDS,
+    CLAIMS_TRENDS_PAGE,
     FIGURE_FORMATS,
     ROLLOUT_TABLES,
     RANKING,
@@ -32,6 +36,10 @@ from efish.layout import (
     seed_name,
     selection_table,
     stacked_seeds_table,
+    stage_copy,
+    stage_name,
+    stage_file,
+    top_seed_copy,
     training_file,
 )
 
@@ -141,9 +149,20 @@ TOP_SEED_HIDDEN = [name for name in TOP_SEED_ASSAYS if assay_config(name).assay.
 CLIP_ASSAYS = [name for name in CFG.scale.clip_assays if name in ASSAYS]
 
 
+# Claims along training (learning.smk). Every seed keeps its policy at the fractions scale.keep_stages of its
+# training (stage_<k>.pt, k = 1..K); at each kept stage the selected seed's policy reruns every claim's assay
+# (SEED_CLAIM_ASSAYS, at most scale.stage_episodes episodes per condition) in results/{run}/learning/stage_<k>/, with
+# the analyses and the claims. A last stage at fraction 1 is the final policy: the run's own claims stand for it.
+KEPT_STAGES = list(range(1, len(CFG.train.keep_stages) + 1))
+LAST_STAGE_IS_FINAL = bool(KEPT_STAGES) and CFG.train.keep_stages[-1] == 1.0
+STAGES = KEPT_STAGES[:-1] if LAST_STAGE_IS_FINAL else KEPT_STAGES  # the stages with their own copy of the layout
+STAGE_ARGS = " ".join([ARGS, shlex.quote(f"scale.max_episodes={CFG.scale.stage_episodes}")])
+
+
 wildcard_constraints:
     run=re.escape(RUN),
     seed=r"\d+",
+    stage=r"\d+",
     assay=r"[A-Za-z0-9_\-]+",
 
 
@@ -152,20 +171,31 @@ RULE_RUN = Run("{run}")  # the rules' patterns ({run} and the rule's other wildc
 THIS_RUN = Run(RUN)  # this run's own files (rule all, panel inputs)
 
 
-def results(relative, seed=None, run=RULE_RUN):
-    """A file under the run's results folder (or top seed ``seed``'s copy of it) from a relative name of
-    efish.layout, e.g. ``results(assay_table("{assay}", "steps"))``."""
-    return str((run if seed is None else run.top_seed(seed)).path(relative))
+# The copies of the layout inside a run (efish.layout.Run.within): a top seed's and a training stage's.
+TOP_SEED = top_seed_copy("{seed}")
+STAGE = stage_copy("{stage}")
 
 
-def log(job, seed=None):
-    """The job's log file, results/{run}/logs/<job>.log (a top seed's under logs/seeds/seed_<n>/)."""
-    return str((RULE_RUN if seed is None else RULE_RUN.top_seed(seed)).log(job))
+def copy_of(wildcards):
+    """The copy of the layout a job of a top seed ({seed}) or a training stage ({stage}) works in; None: the run."""
+    seed, stage = getattr(wildcards, "seed", None), getattr(wildcards, "stage", None)
+    return top_seed_copy(seed) if seed is not None else stage_copy(stage) if stage is not None else None
 
 
-def benchmark(job, seed=None):
+def results(relative, copy=None, run=RULE_RUN):
+    """A file under the run's results folder (or under the copy of the layout ``copy``: TOP_SEED, STAGE) from a
+    relative name of efish.layout, e.g. ``results(assay_table("{assay}", "steps"))``."""
+    return str(run.within(copy).path(relative))
+
+
+def log(job, copy=None):
+    """The job's log file, results/{run}/logs/<job>.log (a copy's under logs/<copy>/)."""
+    return str(RULE_RUN.within(copy).log(job))
+
+
+def benchmark(job, copy=None):
     """The job's Snakemake timing file, results/{run}/benchmarks/<job>.tsv (read by efish bench pipeline)."""
-    return str((RULE_RUN if seed is None else RULE_RUN.top_seed(seed)).benchmark(job))
+    return str(RULE_RUN.within(copy).benchmark(job))
 
 
 def efish(command, arguments=""):
@@ -181,21 +211,21 @@ def folder_of(name, up=0):
     return lambda wildcards, output: str(Path(output[name]).parents[up])
 
 
-def assay_outputs(hidden, seed=None):
-    """The tables an assay job writes, by name (hidden: the assay records the GRU state), in top seed ``seed``'s
-    copy of the layout if given."""
+def assay_outputs(hidden, copy=None):
+    """The tables an assay job writes, by name (hidden: the assay records the GRU state), in the copy of the
+    layout ``copy`` if given."""
     names = [*ROLLOUT_TABLES, *(["hidden"] if hidden else [])]
-    return {t: results(assay_table("{assay}", t), seed) for t in names}
+    return {t: results(assay_table("{assay}", t), copy) for t in names}
 
 
-def analysis_inputs(analysis, seed=None):
-    """The rollout tables an analysis reads, by name, for the {assay} wildcard (of top seed ``seed``)."""
-    return {t: results(assay_table("{assay}", t), seed) for t in analysis.reads}
+def analysis_inputs(analysis, copy=None):
+    """The rollout tables an analysis reads, by name, for the {assay} wildcard (in the copy ``copy``)."""
+    return {t: results(assay_table("{assay}", t), copy) for t in analysis.reads}
 
 
-def analysis_outputs(analysis, run=RULE_RUN, assay="{assay}", seed=None):
-    """The tables an analysis writes, by name (under top seed ``seed``'s copy of the layout if given)."""
-    return {t: results(analysis_table(analysis.name, assay, t), seed, run) for t in analysis.outputs}
+def analysis_outputs(analysis, run=RULE_RUN, assay="{assay}", copy=None):
+    """The tables an analysis writes, by name (under the copy of the layout ``copy`` if given)."""
+    return {t: results(analysis_table(analysis.name, assay, t), copy, run) for t in analysis.outputs}
 
 
 def seed_analysis_assays(analysis):
@@ -213,6 +243,11 @@ def seed_policy(wildcards, seed):
     return results(training_file(seed_name(seed), "final.pt"), run=Run(wildcards.run))
 
 
+def stage_policy(run, seed, k):
+    """Seed ``seed``'s policy at its k-th kept training stage (train.keep_stages)."""
+    return results(training_file(seed_name(seed), stage_file(k)), run=Run(run))
+
+
 def selected_seed(wildcards):
     """The seed the select_seed checkpoint chose."""
     return int(Path(checkpoints.select_seed.get(run=wildcards.run).output.seed).read_text().strip())
@@ -220,12 +255,15 @@ def selected_seed(wildcards):
 
 def assay_policies_input(wildcards):
     """The final checkpoint of every policy an assay's conditions act with, by policy name. The ``selected`` policy
-    is the seed the select_seed checkpoint chose, or seed {seed} for a top seed's rerun."""
-    seed = getattr(wildcards, "seed", None)
+    is the seed the select_seed checkpoint chose (at training stage {stage} for a stage's assays), or seed {seed}
+    for a top seed's rerun."""
+    seed, stage = getattr(wildcards, "seed", None), getattr(wildcards, "stage", None)
 
     def path(name):
         if name != "selected":
             return results(training_file(name, "final.pt"), run=Run(wildcards.run))
+        if stage is not None:
+            return stage_policy(wildcards.run, selected_seed(wildcards), stage)
         return seed_policy(wildcards, selected_seed(wildcards) if seed is None else seed)
 
     return {name: path(name) for name in ASSAY_POLICIES.get(wildcards.assay, ["selected"])}
@@ -252,7 +290,7 @@ def other_top_seeds(wildcards):
 
 def other_seed_claims(wildcards):
     """The claims tables of the other top seeds, in ranking order (the claims rule combines them)."""
-    return [results(CLAIMS_TABLE, seed, Run(wildcards.run)) for seed in other_top_seeds(wildcards)]
+    return [results(CLAIMS_TABLE, top_seed_copy(seed), Run(wildcards.run)) for seed in other_top_seeds(wildcards)]
 
 
 def seed_claims_args(wildcards, input):
@@ -264,15 +302,51 @@ def seed_claims_args(wildcards, input):
 
 def top_seed_tables(wildcards):
     """The episodes tables of the top seeds in assay {assay} (stacked for the supplement)."""
-    return [results(assay_table(wildcards.assay, "episodes"), seed, Run(wildcards.run)) for seed in top_seeds(wildcards)]
+    return [results(assay_table(wildcards.assay, "episodes"), top_seed_copy(seed), Run(wildcards.run))
+            for seed in top_seeds(wildcards)]
 
 
 def claims_inputs(wildcards):
     """The claims' tables among those the assays of this scale write (rollout tables and their analyses); for a top
-    seed's claims (wildcard {seed}) those its rerun assays write in its copy of the layout."""
-    seed = getattr(wildcards, "seed", None)
-    paths = claims_read(ASSAYS) if seed is None else SEED_CLAIM_TABLES
-    return [results(path, seed, Run(wildcards.run)) for path in paths]
+    seed's claims (wildcard {seed}) or a training stage's ({stage}) those its rerun assays write in its copy of the
+    layout."""
+    copy = copy_of(wildcards)
+    paths = claims_read(ASSAYS) if copy is None else SEED_CLAIM_TABLES
+    return [results(path, copy, Run(wildcards.run)) for path in paths]
+
+
+# ------------------------------------------------------------------ learning
+def stage_parts(run=RULE_RUN):
+    """Each kept stage's claim_parts.parquet in stage order: its copy's, or the run's own for a last stage at
+    fraction 1 (the final policy)."""
+    own = [results(CLAIM_PARTS, run=run)] if LAST_STAGE_IS_FINAL else []
+    return [results(CLAIM_PARTS, stage_copy(k), run) for k in STAGES] + own
+
+
+def stage_policies(wildcards):
+    """The selected seed's stage files, k = 1..K (their records hold the env steps trained)."""
+    return [stage_policy(wildcards.run, selected_seed(wildcards), k) for k in KEPT_STAGES]
+
+
+def stage_episodes():
+    """The cap on the episodes per assay condition at each kept stage (the last, at fraction 1, is the run's)."""
+    return [CFG.scale.stage_episodes] * len(STAGES) + [CFG.scale.max_episodes] * LAST_STAGE_IS_FINAL
+
+
+def keyed(values):
+    """``1=a 2=b ...``: efish claims-by-stage's K=VALUE arguments, one per kept stage in order (a string, the
+    placeholder of an input behind a checkpoint not yet run, is passed through)."""
+    if isinstance(values, str):
+        return values
+    return " ".join(f"{k}={v}" for k, v in zip(KEPT_STAGES, values, strict=True))
+
+
+def learning_outputs(run=RULE_RUN):
+    """What claims-by-stage writes: the stacked parts, the trends, the claims page with its trend lines, and the
+    figure (PNG, PDF)."""
+    tables = {"table": CLAIMS_BY_STAGE, "trends": CLAIMS_TRENDS, "page": CLAIMS_TRENDS_PAGE}
+    figure = {ext: str(run.figures / f"{CLAIMS_BY_STAGE_FIGURE}.{ext}") for ext in FIGURE_FORMATS}
+    return {name: results(path, run=run) for name, path in tables.items()} | figure
 
 
 # ------------------------------------------------------------------ figures
@@ -324,4 +398,6 @@ def all_targets():
     targets += [path for figure in FIGURE_PANELS for path in figure_outputs(figure, THIS_RUN)]
     targets += render_targets()
     targets += [results(name, run=THIS_RUN) for name in (CLAIMS_TABLE, CLAIM_PARTS, CLAIMS_PAGE)]
+    if CFG.scale.learning:
+        targets += list(learning_outputs(THIS_RUN).values())
     return targets

@@ -1,13 +1,15 @@
 # Training: every foraging seed of the scale, and every policy recipe an assay asks for
 # (config/policy/<name>.yaml composes its task, arenas and training: homing, homing_raycast). efish train
 # checkpoints beside the declared output and writes final.pt atomically at the
-# end, so a killed job is rerun and resumes from its last checkpoint.
+# end, so a killed job is rerun and resumes from its last checkpoint. A seed also keeps its policy at the
+# fractions scale.keep_stages of its training (stage_<k>.pt) for the claims along training (learning.smk).
 
 
 rule train:
     output:
         final=results(training_file(seed_name("{seed}"), "final.pt")),
         metrics=results(training_file(seed_name("{seed}"), "metrics.parquet")),
+        **{stage_name(k): results(training_file(seed_name("{seed}"), stage_file(k))) for k in KEPT_STAGES},
     log:
         log(f"train/{seed_name('{seed}')}"),
     benchmark:

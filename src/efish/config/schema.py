@@ -251,9 +251,10 @@ class TrainConfig:
     total_steps: int = param("${scale.train_steps}", "env steps per seed (arena steps x arenas); a longer run "
                              "resumes a shorter one's checkpoint", lo=1, neutral=True)
     checkpoint_every: int = param(10, "updates between checkpoints", lo=1, neutral=True)
-    keep_stages: list = param([], "fractions of the run (in (0, 1], increasing) at which to keep the policy as "
-                              "stage_<k>.pt beside checkpoint.pt: the first update whose env steps reach that "
-                              "fraction of the run's, always checkpointed; [] = none", neutral=True)
+    keep_stages: list = param("${scale.keep_stages}", "fractions of the run (in (0, 1], increasing) at which to "
+                              "keep the policy as stage_<k>.pt beside checkpoint.pt: the first update whose env "
+                              "steps reach that fraction of the run's, always checkpointed; [] = none",
+                              neutral=True)
     threads: int = param(1, "torch threads", lo=1, hi=256, neutral=True)
     precision: str = param("auto", "arithmetic of the update's forward passes: fp32, bf16 autocast, or auto (time "
                            "the training GEMM in both at start, take the faster; recorded in provenance.json)",
@@ -340,6 +341,12 @@ class ScaleConfig:
     top_seeds: int = param(3, "the best-ranked seeds (the selected one first): the others rerun every claim's assays "
                            "for seeds_agree, and all run the top_seed_assays (supplement)", lo=0)
     top_seed_assays: list = param(["patchy4", "wide2", "square2"], "assays the top seeds run")
+    keep_stages: list = param([], "fractions of each seed's training at which it keeps its policy for the claims "
+                              "along training (train.keep_stages reads it; [] = none)")
+    learning: bool = param(False, "the claims along training (snakemake learning: the selected seed's assays, "
+                           "analyses and claims at each kept stage) are part of the default target")
+    stage_episodes: int = param(8, "cap on the episodes per assay condition at each kept stage before the last "
+                                "(the last stage, the final policy, is the run's own assays)", lo=1)
     clip_assays: list = param(["homing", "patchy4", "wide2", "onepatch"], "assays whose first episode the report "
                               "shows as a clip (efish render), those of them the scale runs")
     assays: list = param(["homing", "patchy4", "uniform4", "wide2", "square2", "ablation4", "ablation1",
@@ -535,6 +542,8 @@ def _check_consistency(obj: Any, path: str) -> None:
         if (any(isinstance(f, bool) or not isinstance(f, (int, float)) or not 0 < f <= 1 for f in stages)
                 or stages != sorted(set(stages))):
             raise ConfigError(f"{path}keep_stages={stages} must hold strictly increasing fractions in (0, 1]")
+    if isinstance(obj, ScaleConfig) and obj.learning and not obj.keep_stages:
+        raise ConfigError(f"{path}learning=true needs {path}keep_stages (the fractions of training to keep)")
     if isinstance(obj, EnvConfig):
         if obj.n_agents > obj.obs_agents:
             raise ConfigError(f"{path}n_agents={obj.n_agents} exceeds {path}obs_agents={obj.obs_agents} (observation slots)")
