@@ -18,11 +18,13 @@
                                               (one row per part), claims.md; with the other top seeds' claims
                                               tables, seed_verdicts and seeds_agree too; with a claims_trends.parquet,
                                               an "Along training" section in claims.md
-    efish claims-by-stage [overrides] --stages K=PATH ... --env-steps K=N ... [--episodes K=N ...] [--out D]
-                          [--figures D]       the claims' parts at the kept training stages stacked, each part's
+    efish claims-by-stage [overrides] --stages K=PATH ... (--env-steps K=N ... | --stage-policies K=PATH ...)
+                          [--episodes K=N ...] [--claims F] [--out D] [--figures D]
+                                              the claims' parts at the kept training stages stacked, each part's
                                               trend -> claims_by_stage.parquet, claims_trends.parquet (--out,
-                                              default results/<run>/learning) and claims_by_stage.png|pdf
-                                              (--figures, default figures/<run>/learning)
+                                              default results/<run>/learning), claims.md with the trend lines
+                                              (--claims) and claims_by_stage.png|pdf (--figures, default
+                                              figures/<run>/learning)
     efish compare-claims A B                  two runs' claim verdicts, seeds_agree and effects side by side
     efish scene NAME [overrides] --out D      field maps of config/scene/NAME.yaml -> D/NAME.parquet
     efish bench physics [overrides] [--json] [--out D]   sensing throughput, fast vs reference
@@ -56,16 +58,13 @@ from datetime import datetime, timezone
 from pathlib import Path
 from typing import Sequence
 
-from .config import ConfigError, compose, run_name, to_yaml
+from .cli_claims import run_claims, run_claims_by_stage, run_compare_claims
+from .cli_support import run_of, write_metadata
+from .config import ConfigError, compose, to_yaml
 from .layout import (
     BENCH,
-    CLAIM_PARTS,
     CLAIMS_BY_STAGE,
     CLAIMS_BY_STAGE_FIGURE,
-    CLAIMS_PAGE,
-    CLAIMS_TABLE,
-    CLAIMS_TRENDS,
-    CLAIMS_TRENDS_PAGE,
     CONTACT_SHEET,
     RANKING,
     SELECTED_SEED,
@@ -165,7 +164,7 @@ def _parser() -> argparse.ArgumentParser:
                          f"<results>/{RANKING}); alone it adds the seed columns too")
     cl.add_argument("--trends", type=Path, help="a claims_trends.parquet (efish claims-by-stage): claims.md gains an "
                                                 "'Along training' section, one line per claim")
-    cl.set_defaults(handler=_claims)
+    cl.set_defaults(handler=run_claims)
     cbs = sub.add_parser("claims-by-stage", help="the claims' parts at the kept training stages, and whether each is "
                                                  "still moving (a table, the trends, a figure)")
     cbs.add_argument("overrides", nargs="*", help="config overrides (analysis.claims_trend_alpha; the run's name)")
@@ -186,11 +185,11 @@ def _parser() -> argparse.ArgumentParser:
                                               f"(default results/{{run}}/{Path(CLAIMS_BY_STAGE).parent})")
     cbs.add_argument("--figures", type=Path, help="folder for claims_by_stage.png and .pdf "
                                                   f"(default figures/{{run}}/{Path(CLAIMS_BY_STAGE_FIGURE).parent})")
-    cbs.set_defaults(handler=_claims_by_stage)
+    cbs.set_defaults(handler=run_claims_by_stage)
     cc = sub.add_parser("compare-claims", help="two runs' claim verdicts and effect sizes side by side")
     cc.add_argument("a", help="claims.parquet, a claims folder, or a run name (results/<name>/claims/claims.parquet)")
     cc.add_argument("b", help="the same for the second run")
-    cc.set_defaults(handler=_compare_claims)  # no overrides: nothing to compose
+    cc.set_defaults(handler=run_compare_claims)  # no overrides: nothing to compose
     pc = sub.add_parser("plan-cluster", help="expected runtime, memory and cores of every job of a scale, checked "
                                              "against a SLURM profile")
     pc.add_argument("overrides", nargs="*", help="the scale to plan and its overrides, e.g. scale=paper")
@@ -255,18 +254,6 @@ def _bench_parsers(b: argparse.ArgumentParser) -> None:
     bm.set_defaults(handler=_bench_multipole)
 
 
-def _metadata(folder: Path, cfg, started, args, name: str = "provenance.json", **extra) -> None:
-    """config.yaml and provenance (with the command's overrides) beside an output."""
-    from .io import write_run_metadata
-
-    write_run_metadata(folder, to_yaml(cfg), started, {"overrides": list(args.overrides), **extra}, name=name)
-
-
-def _run(cfg, overrides: Sequence[str]) -> Run:
-    """The run the scale and ``overrides`` name: the folders of a command's default outputs (:mod:`efish.layout`)."""
-    return Run(run_name(cfg.scale.name, [o for o in overrides if not o.startswith("scale=")]))
-
-
 def _progress(items: list, label: str, unit: str = "setting", every: int = 1):
     """tqdm bar on a terminal, otherwise a plain line per ``every`` items (and after the last)."""
     if sys.stderr.isatty():
@@ -299,7 +286,7 @@ class ReturnLog:
 def _train(args, cfg, started) -> None:
     from .rl.train import train
 
-    out = args.out or _run(cfg, args.overrides).path(training_folder(seed_name(cfg.train.seed)))
+    out = args.out or run_of(cfg, args.overrides).path(training_folder(seed_name(cfg.train.seed)))
     bar = None
     if sys.stderr.isatty():
         from tqdm import tqdm
@@ -321,7 +308,7 @@ def _train(args, cfg, started) -> None:
     df = train(cfg, out, progress=report, restart=args.restart)
     if bar is not None:
         bar.close()
-    _metadata(out, cfg, started, args, compute=df.attrs["compute"])  # device, precision and how it was chosen
+    write_metadata(out, cfg, started, args, compute=df.attrs["compute"])  # device, precision and how it was chosen
     print(f"trained {len(df)} updates into {out}")
 
 
@@ -332,11 +319,11 @@ def _assay(args, cfg, started) -> None:
 
     paths = policy_paths(args.policy, cfg.assay.policy)
     policies = {name: load_policy(path) for name, path in paths.items()}
-    out = args.out or _run(cfg, args.overrides).path(assay_folder(cfg.assay.name))
+    out = args.out or run_of(cfg, args.overrides).path(assay_folder(cfg.assay.name))
     tables, stats = run_assay(args.overrides, policies, progress=lambda c: print(f"condition {c} done",
                                                                                   file=sys.stderr, flush=True))
     write_tables(tables, out)
-    _metadata(out, cfg, started, args, policies={k: str(v) for k, v in paths.items()}, **stats)
+    write_metadata(out, cfg, started, args, policies={k: str(v) for k, v in paths.items()}, **stats)
     print(f"wrote {', '.join(f'{k}.parquet ({len(v)} rows)' for k, v in tables.items())} to {out} "
           f"({stats['env_steps_per_s']:,.0f} env-steps/s)")
 
@@ -363,7 +350,7 @@ def _select(args, cfg, started) -> None:
     with atomic_path(args.out / Path(RANKING).name) as tmp:
         table.to_parquet(tmp, index=False)
     write_text_atomic(args.out / Path(SELECTED_SEED).name, f"{chosen}\n")
-    _metadata(args.out, cfg, started, args, episodes=[str(p) for p in args.episodes])
+    write_metadata(args.out, cfg, started, args, episodes=[str(p) for p in args.episodes])
     print(table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
     print(f"selected seed {chosen}")
 
@@ -384,7 +371,7 @@ def _analyze(args, cfg, started) -> None:
 
     result = run(args.name, read_tables(args.name, args.tables), cfg)  # everything is read before anything is written
     write_parquet_tables(result, args.out)
-    _metadata(args.out, cfg, started, args, analysis=args.name, tables=str(args.tables))
+    write_metadata(args.out, cfg, started, args, analysis=args.name, tables=str(args.tables))
     print(f"wrote {', '.join(f'{k}.parquet ({len(v)} rows)' for k, v in result.items())} to {args.out}")
 
 
@@ -396,151 +383,12 @@ def _scene(args, cfg, started) -> None:
     if scene_cfg.scene.name != args.name:
         raise ValueError(f"config/scene/{args.name}.yaml names its scene {scene_cfg.scene.name!r}: they must agree")
     table = build_scene(scene_cfg, args.overrides)
-    out = args.out or _run(cfg, args.overrides).path(scene_table(args.name)).parent
+    out = args.out or run_of(cfg, args.overrides).path(scene_table(args.name)).parent
     write_parquet_tables({args.name: to_arrow(table)}, out)
     # the folder holds every scene: one config (the run's) and one provenance per scene, with the scene resolved
-    _metadata(out, cfg, started, args, name=f"{args.name}.provenance.json", scene=args.name,
+    write_metadata(out, cfg, started, args, name=f"{args.name}.provenance.json", scene=args.name,
               scene_config=dataclasses.asdict(scene_cfg.scene))
     print(f"wrote {out / f'{args.name}.parquet'} ({len(table)} rows)")
-
-
-def _claims(args, cfg, started) -> None:
-    from .analysis import claims
-    from .analysis.claims_report import claims_markdown
-    from .analysis.claims_stages import trend_lines
-    from .io import read_parquet, write_parquet_tables, write_text_atomic
-
-    results = args.results or _run(cfg, args.overrides).results
-    if not results.is_dir():
-        raise ValueError(f"results folder {results} does not exist")
-    out = args.out or (results / CLAIMS_TABLE).parent
-    seeds = _seed_claims(args, results)  # read before anything is computed or written
-    trends = None if args.trends is None else trend_lines(read_parquet(args.trends, "the claims' trends table"))
-    table, parts = claims.claims_and_parts(results, cfg)
-    header = (f"Claims of the paper at scale {cfg.scale.name} (run {results.name}), "
-              f"{started.strftime('%Y-%m-%d %H:%M UTC')}")
-    if seeds is not None:
-        from .analysis.claims_seeds import with_seed_verdicts
-
-        selected, others = seeds
-        table = with_seed_verdicts(table, others, selected)
-        header += f"; selected seed {selected}" + (f", other top seeds {', '.join(map(str, others))}" if others else "")
-    table_path, page_path = out / Path(CLAIMS_TABLE).name, out / Path(CLAIMS_PAGE).name
-    write_parquet_tables({table_path.stem: table, Path(CLAIM_PARTS).stem: parts}, out)
-    write_text_atomic(page_path, claims_markdown(table, header, trends))
-    _metadata(out, cfg, started, args, results=str(results),
-              **({} if seeds is None else {"selected_seed": seeds[0], "other_seeds": list(seeds[1])}),
-              **({} if args.trends is None else {"trends": str(args.trends)}))
-    shown = ["claim", "panel", "effect", "ci_low", "ci_high", "n", "p", "verdict"]
-    print(table[shown + ["seeds_agree"] * ("seeds_agree" in table.columns)].to_string(
-        index=False, float_format=lambda v: f"{v:.3g}"))
-    print(f"wrote {table_path}, {out / Path(CLAIM_PARTS).name} and {page_path}")
-
-
-def _seed_claims(args, results: Path):
-    """(selected seed, {other seed: its claims table} in ranking order) from --ranking and --seed-claims, or None
-    when neither is given (the table keeps the columns of ROW_COLUMNS)."""
-    from .io import read_parquet
-
-    if args.seed_claims is None and args.ranking is None:
-        return None
-    ranking_path = args.ranking or results / RANKING
-    if not ranking_path.is_file():
-        raise ValueError(f"no seed ranking at {ranking_path}: --seed-claims needs --ranking (its first row is the "
-                         "selected seed)")
-    ranking = [int(s) for s in read_parquet(ranking_path, "the seed ranking")["seed"]]
-    if not ranking:
-        raise ValueError(f"the seed ranking {ranking_path} has no seed")
-    paths = {seed: Path(path) for seed, path in _keyed(
-        args.seed_claims, "--seed-claims", "SEED", "PATH", "3=results/laptop/seeds/seed_3/claims/claims.parquet").items()}
-    if unknown := sorted(set(paths) - set(ranking)):
-        raise ValueError(f"--seed-claims: seeds {unknown} are not in the ranking {ranking_path} "
-                         f"(seeds {', '.join(map(str, ranking))})")
-    ordered = sorted(paths, key=ranking.index)
-    return ranking[0], {s: read_parquet(paths[s], f"seed {s}'s claims table") for s in ordered}
-
-
-def _keyed(items: Sequence[str] | None, flag: str, key: str, value: str, example: str) -> dict[int, str]:
-    """A flag's ``KEY=VALUE`` entries by integer key (a seed, a stage), in the order given: one line of error for
-    an entry without ``=``, a key that is no whole number, or a key given twice."""
-    found = {}
-    for item in items or []:
-        k, sep, v = item.partition("=")
-        if not (sep and k.strip().isdigit() and v):
-            raise ValueError(f"{flag} {item!r}: write {key}={value}, e.g. {example}")
-        if int(k) in found:
-            raise ValueError(f"{flag} names {key.lower()} {int(k)} twice")
-        found[int(k)] = v
-    return found
-
-
-def _stage_counts(items: Sequence[str] | None, flag: str) -> dict[int, int]:
-    """``--env-steps`` / ``--episodes``: ``K=N`` entries, N a whole number."""
-    counts = _keyed(items, flag, "K", "N", "1=250000")
-    if bad := [f"{k}={v}" for k, v in counts.items() if not v.strip().isdigit()]:
-        raise ValueError(f"{flag} {', '.join(bad)}: N must be a whole number, e.g. 1=250000")
-    return {k: int(v) for k, v in counts.items()}
-
-
-def _stage_env_steps(items: Sequence[str]) -> dict[int, int]:
-    """``--stage-policies``: the env steps each stage file records (train.keep_stages)."""
-    from .rl.policy import read_stage
-
-    return {k: int(read_stage(path)["env_steps"])
-            for k, path in _keyed(items, "--stage-policies", "K", "PATH", "1=results/study/train/seed_3/stage_1.pt").items()}
-
-
-def _read_stage(k: int, where: Path):
-    """(path, table) of stage ``k``'s parts table, from its claim_parts.parquet, its claims folder or its results
-    folder."""
-    from .io import read_parquet
-
-    candidates = [where, where / Path(CLAIM_PARTS).name, where / CLAIM_PARTS]
-    path = next((c for c in candidates if c.is_file()), None)
-    if path is None:
-        raise ValueError(f"--stages {k}: no parts table at {', '.join(map(str, candidates))} (run efish claims "
-                         "there first)")
-    return path, read_parquet(path, f"stage {k}'s parts table")
-
-
-def _claims_by_stage(args, cfg, started) -> None:
-    from .analysis.claims_report import claims_markdown
-    from .analysis.claims_stages import claims_by_stage, stage_trends, trend_lines
-    from .figures.learning import plot_claims_by_stage
-    from .io import read_parquet, write_parquet_tables, write_text_atomic
-
-    run = _run(cfg, args.overrides)
-    out = args.out or run.path(CLAIMS_BY_STAGE).parent
-    figures = args.figures or (run.figures / CLAIMS_BY_STAGE_FIGURE).parent
-    read = {k: _read_stage(k, Path(p)) for k, p in _keyed(args.stages, "--stages", "K", "PATH",
-                                                           "1=results/laptop/learning/stage_1").items()}
-    env_steps = (_stage_counts(args.env_steps, "--env-steps") if args.env_steps is not None
-                 else _stage_env_steps(args.stage_policies))
-    episodes = _stage_counts(args.episodes, "--episodes")
-    final = read_parquet(args.claims, "the run's claims table") if args.claims is not None else None
-    stacked = claims_by_stage({k: table for k, (_, table) in read.items()}, env_steps, episodes or None)
-    trends = stage_trends(stacked, cfg.analysis.claims_trend_alpha)
-    drawn = plot_claims_by_stage(stacked, figures / Path(CLAIMS_BY_STAGE_FIGURE).name, trends)
-    tables = write_parquet_tables({Path(CLAIMS_BY_STAGE).stem: stacked, Path(CLAIMS_TRENDS).stem: trends}, out)
-    if final is not None:
-        header = (f"Claims of the paper at scale {cfg.scale.name} (run {run.name}), the selected seed's final policy, "
-                  f"with each claim's trend over {len(env_steps)} training stages, {started.strftime('%Y-%m-%d %H:%M UTC')}")
-        tables.append(out / Path(CLAIMS_TRENDS_PAGE).name)
-        write_text_atomic(tables[-1], claims_markdown(final, header, trend_lines(trends)))
-    inputs = {"stages": {str(k): str(path) for k, (path, _) in read.items()},
-              "env_steps": {str(k): n for k, n in env_steps.items()},
-              "episodes": {str(k): n for k, n in episodes.items()}}
-    _metadata(out, cfg, started, args, name="claims_by_stage.provenance.json", **inputs)
-    _metadata(figures, cfg, started, args, name="claims_by_stage.provenance.json", table=str(tables[0]))
-    print("\n".join(trend_lines(trends).values()))
-    print(f"wrote {', '.join(map(str, tables + drawn))}")
-
-
-def _compare_claims(args, cfg, started) -> None:
-    from .analysis.claims_report import compare_claims, load_claims
-
-    (name_a, a), (name_b, b) = load_claims(args.a), load_claims(args.b)
-    print(compare_claims(a, b, (name_a, name_b)).to_string(index=False))
 
 
 def _figure(args, cfg, started) -> None:
@@ -549,7 +397,7 @@ def _figure(args, cfg, started) -> None:
     from .figures.registry import drawable, figures
     from .figures.render import render_figure, render_panel
 
-    run = _run(cfg, args.overrides)
+    run = run_of(cfg, args.overrides)
     results = args.results or run.results
     out = args.out or run.figures
     if args.key.startswith(f"{BENCH}/"):
@@ -564,7 +412,7 @@ def _figure(args, cfg, started) -> None:
         drawn = render_figure(args.key, panels, results, out, cfg.scale.seeds)
     # one provenance per drawn output (a figure folder holds many panels), one config per folder
     for key, files in drawn.items():
-        _metadata(files[0].parent, cfg, started, args, name=f"{files[0].stem}.provenance.json", figure=key,
+        write_metadata(files[0].parent, cfg, started, args, name=f"{files[0].stem}.provenance.json", figure=key,
                   results=str(results))
     written = [path for files in drawn.values() for path in files]
     print("wrote " + ", ".join(map(str, written)))
@@ -574,14 +422,14 @@ def _render(args, cfg, started) -> None:
     from .figures.episode import clip_writer, load_episode, render_clip
 
     # assay= picks the tables, not the run: the default folders are the run's (results/smoke for scale=smoke)
-    run = _run(cfg, [o for o in args.overrides if not o.startswith("assay=")])
+    run = run_of(cfg, [o for o in args.overrides if not o.startswith("assay=")])
     tables = args.tables or run.path(assay_folder(cfg.assay.name))
     out = args.out or run.clip(cfg.assay.name)
     clip_writer(out)  # a wrong suffix, or .mp4 without ffmpeg, fails before any table is read
     episode = load_episode(tables, args.overrides, cfg, args.condition, args.episode)
     frames = render_clip(episode, out, every=args.every, fps=args.fps, field=args.field,
                          progress=lambda rows: _progress(rows, "frames", unit="frame", every=max(1, len(rows) // 10)))
-    _metadata(out.parent, cfg, started, args, name=f"{out.stem}.provenance.json", tables=str(tables),
+    write_metadata(out.parent, cfg, started, args, name=f"{out.stem}.provenance.json", tables=str(tables),
               condition=episode.condition, episode=episode.episode)
     print(f"wrote {out} ({frames} frames of {episode.assay}, condition {episode.condition}, "
           f"episode {episode.episode})")
@@ -590,10 +438,10 @@ def _render(args, cfg, started) -> None:
 def _contact_sheet(args, cfg, started) -> None:
     from .figures.contact_sheet import write_contact_sheet
 
-    figures = args.figures or _run(cfg, args.overrides).figures
+    figures = args.figures or run_of(cfg, args.overrides).figures
     out = args.out or figures / CONTACT_SHEET
     drawn, absent = write_contact_sheet(figures, out)
-    _metadata(out.parent, cfg, started, args, name=f"{out.stem}.provenance.json", figures=str(figures))
+    write_metadata(out.parent, cfg, started, args, name=f"{out.stem}.provenance.json", figures=str(figures))
     print(f"wrote {out} (panels drawn: {drawn}; not drawn at this scale: {absent})")
 
 
@@ -645,7 +493,7 @@ def _bench_physics(args, cfg, started) -> None:
     print(json.dumps(result, indent=2) if args.json else format_physics(result))
     if args.out:
         write_text_atomic(args.out / "bench_physics.json", json.dumps(result, indent=2) + "\n")
-        _metadata(args.out, cfg, started, args)
+        write_metadata(args.out, cfg, started, args)
 
 
 def _bench_env(args, cfg, started) -> None:
@@ -676,14 +524,14 @@ def _bench_budget(args, cfg, started) -> None:
     if args.out:
         with atomic_path(args.out / "bench_budget.parquet") as tmp:
             table.to_parquet(tmp, index=False)
-        _metadata(args.out, cfg, started, args, name="bench_budget.provenance.json")
+        write_metadata(args.out, cfg, started, args, name="bench_budget.provenance.json")
     print(format_budget(table))
 
 
 def _bench_pipeline(args, cfg, started) -> None:
     from .bench.pipeline import format_timings, pipeline_timings
 
-    table = pipeline_timings(args.results or _run(cfg, args.overrides).results)
+    table = pipeline_timings(args.results or run_of(cfg, args.overrides).results)
     print(table.to_json(orient="records", indent=1) if args.json else format_timings(table))
 
 
@@ -700,14 +548,14 @@ def _bench_with_figure(name: str, df, args, cfg, started) -> tuple[Path, list[Pa
     from .bench.figures import draw_bench_figure, stem
     from .io import atomic_path
 
-    run = _run(cfg, args.overrides)
+    run = run_of(cfg, args.overrides)
     out, figures = args.out or run.bench, args.figures or run.bench_figures
     table = out / f"{stem(name)}.parquet"
     with atomic_path(table) as tmp:
         df.to_parquet(tmp, index=False)
-    _metadata(out, cfg, started, args, name=f"{stem(name)}.provenance.json")
+    write_metadata(out, cfg, started, args, name=f"{stem(name)}.provenance.json")
     written = draw_bench_figure(name, df, figures)
-    _metadata(figures, cfg, started, args, name=f"{stem(name)}.provenance.json", table=str(table))
+    write_metadata(figures, cfg, started, args, name=f"{stem(name)}.provenance.json", table=str(table))
     return table, written
 
 

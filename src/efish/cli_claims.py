@@ -1,0 +1,159 @@
+"""The claims commands of ``efish``: ``claims`` (a run's verdicts, with the other top seeds' and the trends along
+training), ``claims-by-stage`` (the claims at the kept training stages) and ``compare-claims`` (two runs side by
+side). Their parsers are in :mod:`efish.cli`."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+from .cli_support import run_of, write_metadata
+from .layout import (
+    CLAIM_PARTS,
+    CLAIMS_BY_STAGE,
+    CLAIMS_BY_STAGE_FIGURE,
+    CLAIMS_PAGE,
+    CLAIMS_TABLE,
+    CLAIMS_TRENDS,
+    CLAIMS_TRENDS_PAGE,
+    RANKING,
+)
+
+
+def run_claims(args, cfg, started) -> None:
+    from .analysis import claims
+    from .analysis.claims_report import claims_markdown
+    from .analysis.claims_stages import trend_lines
+    from .io import read_parquet, write_parquet_tables, write_text_atomic
+
+    results = args.results or run_of(cfg, args.overrides).results
+    if not results.is_dir():
+        raise ValueError(f"results folder {results} does not exist")
+    out = args.out or (results / CLAIMS_TABLE).parent
+    seeds = _seed_claims(args, results)  # read before anything is computed or written
+    trends = None if args.trends is None else trend_lines(read_parquet(args.trends, "the claims' trends table"))
+    table, parts = claims.claims_and_parts(results, cfg)
+    header = (f"Claims of the paper at scale {cfg.scale.name} (run {results.name}), "
+              f"{started.strftime('%Y-%m-%d %H:%M UTC')}")
+    if seeds is not None:
+        from .analysis.claims_seeds import with_seed_verdicts
+
+        selected, others = seeds
+        table = with_seed_verdicts(table, others, selected)
+        header += f"; selected seed {selected}" + (f", other top seeds {', '.join(map(str, others))}" if others else "")
+    table_path, page_path = out / Path(CLAIMS_TABLE).name, out / Path(CLAIMS_PAGE).name
+    write_parquet_tables({table_path.stem: table, Path(CLAIM_PARTS).stem: parts}, out)
+    write_text_atomic(page_path, claims_markdown(table, header, trends))
+    write_metadata(out, cfg, started, args, results=str(results),
+              **({} if seeds is None else {"selected_seed": seeds[0], "other_seeds": list(seeds[1])}),
+              **({} if args.trends is None else {"trends": str(args.trends)}))
+    shown = ["claim", "panel", "effect", "ci_low", "ci_high", "n", "p", "verdict"]
+    print(table[shown + ["seeds_agree"] * ("seeds_agree" in table.columns)].to_string(
+        index=False, float_format=lambda v: f"{v:.3g}"))
+    print(f"wrote {table_path}, {out / Path(CLAIM_PARTS).name} and {page_path}")
+
+
+def _seed_claims(args, results: Path):
+    """(selected seed, {other seed: its claims table} in ranking order) from --ranking and --seed-claims, or None
+    when neither is given (the table keeps the columns of ROW_COLUMNS)."""
+    from .io import read_parquet
+
+    if args.seed_claims is None and args.ranking is None:
+        return None
+    ranking_path = args.ranking or results / RANKING
+    if not ranking_path.is_file():
+        raise ValueError(f"no seed ranking at {ranking_path}: --seed-claims needs --ranking (its first row is the "
+                         "selected seed)")
+    ranking = [int(s) for s in read_parquet(ranking_path, "the seed ranking")["seed"]]
+    if not ranking:
+        raise ValueError(f"the seed ranking {ranking_path} has no seed")
+    paths = {seed: Path(path) for seed, path in _keyed(
+        args.seed_claims, "--seed-claims", "SEED", "PATH", "3=results/laptop/seeds/seed_3/claims/claims.parquet").items()}
+    if unknown := sorted(set(paths) - set(ranking)):
+        raise ValueError(f"--seed-claims: seeds {unknown} are not in the ranking {ranking_path} "
+                         f"(seeds {', '.join(map(str, ranking))})")
+    ordered = sorted(paths, key=ranking.index)
+    return ranking[0], {s: read_parquet(paths[s], f"seed {s}'s claims table") for s in ordered}
+
+
+def _keyed(items: Sequence[str] | None, flag: str, key: str, value: str, example: str) -> dict[int, str]:
+    """A flag's ``KEY=VALUE`` entries by integer key (a seed, a stage), in the order given: one line of error for
+    an entry without ``=``, a key that is no whole number, or a key given twice."""
+    found = {}
+    for item in items or []:
+        k, sep, v = item.partition("=")
+        if not (sep and k.strip().isdigit() and v):
+            raise ValueError(f"{flag} {item!r}: write {key}={value}, e.g. {example}")
+        if int(k) in found:
+            raise ValueError(f"{flag} names {key.lower()} {int(k)} twice")
+        found[int(k)] = v
+    return found
+
+
+def _stage_counts(items: Sequence[str] | None, flag: str) -> dict[int, int]:
+    """``--env-steps`` / ``--episodes``: ``K=N`` entries, N a whole number."""
+    counts = _keyed(items, flag, "K", "N", "1=250000")
+    if bad := [f"{k}={v}" for k, v in counts.items() if not v.strip().isdigit()]:
+        raise ValueError(f"{flag} {', '.join(bad)}: N must be a whole number, e.g. 1=250000")
+    return {k: int(v) for k, v in counts.items()}
+
+
+def _stage_env_steps(items: Sequence[str]) -> dict[int, int]:
+    """``--stage-policies``: the env steps each stage file records (train.keep_stages)."""
+    from .rl.policy import read_stage
+
+    return {k: int(read_stage(path)["env_steps"])
+            for k, path in _keyed(items, "--stage-policies", "K", "PATH", "1=results/study/train/seed_3/stage_1.pt").items()}
+
+
+def _read_stage(k: int, where: Path):
+    """(path, table) of stage ``k``'s parts table, from its claim_parts.parquet, its claims folder or its results
+    folder."""
+    from .io import read_parquet
+
+    candidates = [where, where / Path(CLAIM_PARTS).name, where / CLAIM_PARTS]
+    path = next((c for c in candidates if c.is_file()), None)
+    if path is None:
+        raise ValueError(f"--stages {k}: no parts table at {', '.join(map(str, candidates))} (run efish claims "
+                         "there first)")
+    return path, read_parquet(path, f"stage {k}'s parts table")
+
+
+def run_claims_by_stage(args, cfg, started) -> None:
+    from .analysis.claims_report import claims_markdown
+    from .analysis.claims_stages import claims_by_stage, stage_trends, trend_lines
+    from .figures.learning import plot_claims_by_stage
+    from .io import read_parquet, write_parquet_tables, write_text_atomic
+
+    run = run_of(cfg, args.overrides)
+    out = args.out or run.path(CLAIMS_BY_STAGE).parent
+    figures = args.figures or (run.figures / CLAIMS_BY_STAGE_FIGURE).parent
+    read = {k: _read_stage(k, Path(p)) for k, p in _keyed(args.stages, "--stages", "K", "PATH",
+                                                           "1=results/laptop/learning/stage_1").items()}
+    env_steps = (_stage_counts(args.env_steps, "--env-steps") if args.env_steps is not None
+                 else _stage_env_steps(args.stage_policies))
+    episodes = _stage_counts(args.episodes, "--episodes")
+    final = read_parquet(args.claims, "the run's claims table") if args.claims is not None else None
+    stacked = claims_by_stage({k: table for k, (_, table) in read.items()}, env_steps, episodes or None)
+    trends = stage_trends(stacked, cfg.analysis.claims_trend_alpha)
+    drawn = plot_claims_by_stage(stacked, figures / Path(CLAIMS_BY_STAGE_FIGURE).name, trends)
+    tables = write_parquet_tables({Path(CLAIMS_BY_STAGE).stem: stacked, Path(CLAIMS_TRENDS).stem: trends}, out)
+    if final is not None:
+        header = (f"Claims of the paper at scale {cfg.scale.name} (run {run.name}), the selected seed's final policy, "
+                  f"with each claim's trend over {len(env_steps)} training stages, {started.strftime('%Y-%m-%d %H:%M UTC')}")
+        tables.append(out / Path(CLAIMS_TRENDS_PAGE).name)
+        write_text_atomic(tables[-1], claims_markdown(final, header, trend_lines(trends)))
+    inputs = {"stages": {str(k): str(path) for k, (path, _) in read.items()},
+              "env_steps": {str(k): n for k, n in env_steps.items()},
+              "episodes": {str(k): n for k, n in episodes.items()}}
+    write_metadata(out, cfg, started, args, name="claims_by_stage.provenance.json", **inputs)
+    write_metadata(figures, cfg, started, args, name="claims_by_stage.provenance.json", table=str(tables[0]))
+    print("\n".join(trend_lines(trends).values()))
+    print(f"wrote {', '.join(map(str, tables + drawn))}")
+
+
+def run_compare_claims(args, cfg, started) -> None:
+    from .analysis.claims_report import compare_claims, load_claims
+
+    (name_a, a), (name_b, b) = load_claims(args.a), load_claims(args.b)
+    print(compare_claims(a, b, (name_a, name_b)).to_string(index=False))
