@@ -341,11 +341,13 @@ def keyed(values):
     return " ".join(f"{k}={v}" for k, v in zip(KEPT_STAGES, values, strict=True))
 
 
-def learning_outputs(run=RULE_RUN):
+def learning_outputs(run=RULE_RUN, reported=False):
     """What claims-by-stage writes: the stacked parts, the trends, the claims page with its trend lines, and the
-    figure (PNG, PDF)."""
+    figure (PNG, PDF); ``reported``: the figure's PNG goes into the report, beside the claims."""
     tables = {"table": CLAIMS_BY_STAGE, "trends": CLAIMS_TRENDS, "page": CLAIMS_TRENDS_PAGE}
     figure = {ext: str(run.figures / f"{CLAIMS_BY_STAGE_FIGURE}.{ext}") for ext in FIGURE_FORMATS}
+    if reported:
+        figure["png"] = report(figure["png"], caption="../report/learning.rst", category="Claims")
     return {name: results(path, run=run) for name, path in tables.items()} | figure
 
 

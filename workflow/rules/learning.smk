@@ -53,7 +53,7 @@ rule claims_by_stage:
         policies=stage_policies,
         claims=results(CLAIMS_TABLE),
     output:
-        **learning_outputs(),
+        **learning_outputs(reported=True),
     log:
         log("learning"),
     benchmark:
