@@ -174,6 +174,8 @@ def test_efish_claims_by_stage_reads_env_steps_from_the_stage_files_and_writes_t
     (lambda a: [x for x in a if x != "4=100000"], "no env steps for stages [4]"),
     (lambda a: [x.replace("stage_2", "stage_9") for x in a], "--stages 2: no parts table at"),
     (lambda a: [*a[:2], a[1], *a[2:]], "--stages names k 1 twice"),
+    (lambda a: [*a[:a.index("--env-steps")], "--stage-policies", "1=nowhere.pt"], "no stage file at nowhere.pt"),
+    (lambda a: [*a, "--claims", "nowhere.parquet"], "nowhere.parquet"),
 ])
 def test_efish_claims_by_stage_refuses_bad_stages_in_one_line_and_writes_nothing(tmp_path, capsys, change, message):
     args = stage_args(tmp_path)

@@ -120,6 +120,8 @@ def test_overrides_reach_every_efish_call(tmp_path):
     (["overrides=physics.tolerance=-1"], [], "efish config: physics.tolerance=-1.0 is out of range"),
     (["overrides=physics.nonsense=1"], [], "efish config: unknown config key 'physics.nonsense'"),
     (["overrides=scale.assays=[nope]"], [], "unknown assay 'nope'"),
+    (["overrides=scale.keep_stages=[]"], ["learning"], "the learning target needs scale.keep_stages"),
+    (["overrides=scale.learning=true scale.keep_stages=[]"], [], "learning=true needs scale.keep_stages"),
 ])
 def test_bad_input_fails_before_any_job(tmp_path, config, target, message):
     result = dry_run(tmp_path, *target, "--config", "scale=smoke", *config)

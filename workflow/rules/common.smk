@@ -333,6 +333,14 @@ def stage_episodes():
     return [CFG.scale.stage_episodes] * len(STAGES) + [CFG.scale.max_episodes] * LAST_STAGE_IS_FINAL
 
 
+def learning_target(wildcards):
+    """The learning target's inputs; without stages one line and no job (it would otherwise train and assay for
+    nothing before failing)."""
+    if not KEPT_STAGES:
+        fail("the learning target needs scale.keep_stages, e.g. --config overrides=\"scale.keep_stages=[0.5,1.0]\"")
+    return list(learning_outputs(THIS_RUN).values())
+
+
 def keyed(values):
     """``1=a 2=b ...``: efish claims-by-stage's K=VALUE arguments, one per kept stage in order (a string, the
     placeholder of an input behind a checkpoint not yet run, is passed through)."""

@@ -74,4 +74,4 @@ rule claims_by_stage:
 
 rule learning:
     input:
-        **learning_outputs(THIS_RUN),
+        learning_target,
