@@ -1,6 +1,6 @@
 """The package's layers import one way, and the table-reading layers load neither numba nor torch.
 
-Layers, ground floor first (DESIGN "Layout"): config <- physics <- sensors <- env
+Layers, ground floor first (docs/architecture.md#layout): config <- physics <- sensors <- env
 <- rl <- rollout <- analysis <- figures <- bench, cli. A module may import its
 own layer and the layers below, never one above (imports inside functions
 count too: a lazy import is still a dependency).

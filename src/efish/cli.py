@@ -103,7 +103,8 @@ def _parser() -> argparse.ArgumentParser:
     sch.add_argument("table", choices=("steps", "episodes", "food", "hidden", "conditions"))
     sch.add_argument("overrides", nargs="*")
     sch.set_defaults(handler=_schema)
-    sel = sub.add_parser("select", help="rank seeds from their evaluation episodes (SPEC 10)")
+    sel = sub.add_parser("select",
+                         help="rank seeds from their evaluation episodes (docs/methods/training.md#seed-selection)")
     sel.add_argument("overrides", nargs="*", help="config overrides, recorded in config.yaml (e.g. scale=laptop)")
     sel.add_argument("--episodes", nargs="+", type=Path, required=True,
                      help="episodes.parquet files in folders named seed_<n>")
@@ -151,7 +152,7 @@ def _parser() -> argparse.ArgumentParser:
     cs.add_argument("--figures", type=Path, help="figure folder of the run (default figures/{run})")
     cs.add_argument("--out", type=Path, help=f"the sheet, a .png (default <figures>/{CONTACT_SHEET})")
     cs.set_defaults(handler=_contact_sheet)
-    cl = sub.add_parser("claims", help="the claims of CLAIMS.md as verdicts from a run's tables")
+    cl = sub.add_parser("claims", help="the paper's claims (docs/claims/index.md) as verdicts from a run's tables")
     cl.add_argument("overrides", nargs="*", help="config overrides, e.g. scale=smoke analysis.claims_resamples=200")
     cl.add_argument("--results", type=Path, help="the run's results folder (default results/{run})")
     cl.add_argument("--out", type=Path, help="folder for claims.parquet and claims.md (default <results>/claims)")

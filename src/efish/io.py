@@ -1,4 +1,4 @@
-"""Atomic writes and provenance for every output folder (DESIGN "Config")."""
+"""Atomic writes and provenance for every output folder (docs/architecture.md#config)."""
 
 from __future__ import annotations
 

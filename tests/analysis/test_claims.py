@@ -1,5 +1,5 @@
-"""The claims (CLAIMS.md): each claim holds on tables built so that it holds and fails on tables built the other
-way round; missing tables give ``not run`` with a reason; reruns are identical; ``efish claims`` and
+"""The claims (docs/claims/index.md): each claim holds on tables built so that it holds and fails on tables built the
+other way round; missing tables give ``not run`` with a reason; reruns are identical; ``efish claims`` and
 ``efish compare-claims`` write and print what they promise."""
 
 from __future__ import annotations

@@ -15,7 +15,7 @@ from efish.rollout.schema import SCHEMAS, to_table
 
 from ..helpers import cfg_with, conditions_of, rollout_tables
 
-#: The assays of SPEC 11 (config/assay/<name>.yaml as they land).
+#: The assays of docs/methods/assays.md (config/assay/<name>.yaml as they land).
 SPEC_ASSAYS = {"homing", "patchy4", "uniform4", "wide2", "square2", "ablation4", "ablation1", "collective", "mute",
                "npatch", "food_scarcity", "onepatch", "bot", "groupsize"}
 

@@ -1,4 +1,4 @@
-"""Food layouts and arena sampling against their SPEC 8 statistics."""
+"""Food layouts and arena sampling against their statistics (docs/model/environment.md#arenas-and-food)."""
 
 from __future__ import annotations
 

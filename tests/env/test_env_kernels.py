@@ -1,7 +1,8 @@
 """Numba kernels of the env step against the numpy formulas they replaced, bit for bit (-0.0 included).
 
-The numpy versions below are the oracles: the SPEC 4 tail, the SPEC 7 foraging
-rewards, the body-frame displacement and np.mod for the orientation drift.
+The numpy versions below are the oracles: the observation tail
+(docs/model/environment.md#observation), the foraging rewards
+(docs/model/environment.md#rewards), the body-frame displacement and np.mod for the orientation drift.
 """
 
 from __future__ import annotations
@@ -45,7 +46,8 @@ def test_tail_kernel_equals_the_numpy_tail():
 
 
 def numpy_foraging(c, ate, d_prev, d_now, perimeter, penalty_bitten, bit, collided, move, turn):
-    """SPEC 7 foraging components as whole-array numpy expressions, summed with Python's ``sum``."""
+    """Foraging reward components (docs/model/environment.md#rewards) as whole-array numpy expressions, summed with
+    Python's ``sum``."""
     shaping = (d_prev - d_now) / perimeter[:, None]
     parts = {
         "food": c.reward_food * ate,

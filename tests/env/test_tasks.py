@@ -1,4 +1,4 @@
-"""Bot, homing and ray-casting baselines (SPEC 7, 11)."""
+"""Bot, homing and ray-casting baselines (docs/model/environment.md#rewards, docs/methods/assays.md)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,5 @@
-"""The registry draws every panel SPEC 13 lists, and every registered panel draws from real-shaped tables."""
+"""The registry draws every panel docs/methods/figures.md#panels lists, and every registered panel draws from
+real-shaped tables."""
 
 from __future__ import annotations
 
@@ -16,7 +17,7 @@ def letters(last: str) -> list[str]:
     return list(string.ascii_uppercase[: string.ascii_uppercase.index(last) + 1])
 
 
-#: Written from SPEC 13 (figure -> its panel letters; the supplement's panels by name).
+#: Written from docs/methods/figures.md#panels (figure -> its panel letters; the supplement's panels by name).
 SPEC_13 = {
     "fig1": letters("H"),  # A training loop ... H snapshot + EOD raster
     "fig2": letters("D"),  # A homing scene ... D error angle vs normalised time

@@ -1,9 +1,9 @@
-"""Detection ranges of the receptor classes (SPEC 3.5, supplement of the paper).
+"""Detection ranges of the receptor classes (docs/model/sensors.md#calibration-checks, supplement of the paper).
 
 A target sits on the observer's heading axis in a 400 x 400 cm arena with no
-wall images (physics.image_order=0) and no noise (rng=None). The SPEC ranges
+wall images (physics.image_order=0) and no noise (rng=None). The documented ranges
 are Mormyromast prey 5 cm / agent 10 cm, Ampullary prey 4 cm / agent 8 cm,
-Knollenorgan agent 100 cm. "Inside" is 90 % of the SPEC range; "clearly
+Knollenorgan agent 100 cm. "Inside" is 90 % of the documented range; "clearly
 outside" is twice the range.
 
 Measured with this model (scan in 0.01 cm steps, 0.05 cm for Knollenorgans;
@@ -13,7 +13,7 @@ orientation) to 5.6 cm (along the axis), agent 11.0 cm; Knollenorgan 100.9 cm fo
 an emitter whose EOD axis points at the listener (79.25 cm broadside).
 The passive and active ranges come out 10-40 % beyond the supplement's round
 numbers (the supplement's figures are estimates at the E_min thresholds), so
-2x the SPEC range is a margin of >= 1.4x over every measured edge, while
+2x the documented range is a margin of >= 1.4x over every measured edge, while
 0.9x the range is inside every measured edge.
 """
 
@@ -94,7 +94,8 @@ def test_ampullary_detects_a_silent_agent_within_8_cm(cfg, reference):
 
 
 def test_ampullary_alone_reads_nothing_in_free_space(cfg):
-    # the own intrinsic field is removed (SPEC 3.2); with no walls and nobody else, all zero
+    # the own intrinsic field is removed (docs/model/sensors.md#ampullary-organs); with no walls and nobody else,
+    # all zero
     r = sense(pellet_ahead(200.0, 0.0, emitting=True), cfg)
     assert np.all(observer_reads(r, "ampullary") == 0)
 

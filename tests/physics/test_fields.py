@@ -1,4 +1,5 @@
-"""Closed-form point-source fields (SPEC 2.4) and the calibration ratios of SPEC 3.5."""
+"""Closed-form point-source fields (docs/model/physics.md#field-sources) and the calibration ratios of
+docs/model/sensors.md#calibration-checks."""
 
 from __future__ import annotations
 
@@ -12,12 +13,12 @@ EPS0, SOFTENING_M = PhysicsConfig().eps0, PhysicsConfig().softening_m  # the fie
 
 K = 1.0 / (4.0 * np.pi * EPS0)
 CM = 0.01
-Q = 1.11e-15          # EOD monopole charge, C (SPEC 2.1)
+Q = 1.11e-15          # EOD monopole charge, C (docs/model/physics.md#field-sources)
 P_EOD = Q * 1.0 * CM  # +q and -q 1 cm apart: EOD dipole moment, C m
 
 
 def test_coulomb_constant():
-    # SPEC eps0 = 8.854e-12 F/m (not CODATA's 8.8541878e-12): k = 8.98774e9 V m / C
+    # eps0 of docs/model/physics.md#field-sources = 8.854e-12 F/m (not CODATA's 8.8541878e-12): k = 8.98774e9 V m / C
     assert coulomb_constant() == pytest.approx(8.98774e9, rel=1e-5)
     assert EPS0 == 8.854e-12
     assert coulomb_constant(2 * EPS0) == pytest.approx(coulomb_constant() / 2, rel=1e-15)
@@ -115,7 +116,7 @@ def test_no_sources_gives_zero_field():
     np.testing.assert_array_equal(e, 0.0)
 
 
-# ------------------------------------------------------------------ SPEC 3.5 ratios
+# ------------------------------------ calibration ratios (docs/model/sensors.md#calibration-checks)
 def test_self_eod_vs_prey_induced_ratio():
     """Self-EOD field at a sensor / prey-induced field there = x^3 |x-r|^3 / (2 |chi| R^3 r^3).
 
@@ -128,7 +129,7 @@ def test_self_eod_vs_prey_induced_ratio():
     eod = dict(positions=[[0.0, 0.0]], moments=[[P_EOD, 0.0]])
     e_self = dipole_field(sensor, **eod)
     e_at_prey = dipole_field(prey, **eod)
-    p_ind = 4 * np.pi * EPS0 * R**3 * chi * e_at_prey           # SPEC 2.3
+    p_ind = 4 * np.pi * EPS0 * R**3 * chi * e_at_prey           # docs/model/physics.md#induction
     e_ind = dipole_field(sensor, prey, p_ind)
     ratio = np.linalg.norm(e_self) / np.linalg.norm(e_ind)
     formula = x**3 * abs(x - r) ** 3 / (2 * abs(chi) * R**3 * r**3)

@@ -1,4 +1,4 @@
-"""Where the sensors sit (SPEC 3)."""
+"""Where the sensors sit (docs/model/sensors.md)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Method of images for the insulating rectangular arena (SPEC 2.5)."""
+"""Method of images for the insulating rectangular arena (docs/model/physics.md#walls-and-images)."""
 
 from __future__ import annotations
 
@@ -111,7 +111,7 @@ def test_dipole_and_its_mirrored_image_satisfy_the_insulating_boundary_condition
 
 
 def test_a_copied_dipole_vector_would_violate_the_boundary_condition():
-    # the SPEC D decision (mirror, not copy) matters: a copied normal component leaves E.n != 0
+    # the decision of docs/model/differences.md (mirror, not copy) matters: a copied normal component leaves E.n != 0
     xy = np.array([[0.31, 0.07]])
     vec = 1e-20 * np.array([[1.0, 0.0]])
     pos, _, _ = image_sources(xy, vec, W, H, single_wall("left"), 1.0)

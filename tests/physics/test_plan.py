@@ -29,7 +29,7 @@ def test_default_plan_runs_every_effect(default_cfg):
     for name in ("fields", "mormyromast", "ampullary", "knollenorgan", "eod_emission", "induction",
                  "self_part", "cons_part", "intrinsic_fields", "pellets", "wall_images", "noise", "culling"):
         assert plan.on(name), name
-    assert not plan.on("wall_distortion")  # default off (SPEC 3.1)
+    assert not plan.on("wall_distortion")  # default off (docs/model/sensors.md#mormyromasts)
     with pytest.raises(KeyError, match="no_such_effect"):
         plan.on("no_such_effect")
 
@@ -161,7 +161,7 @@ def test_plan_constants_in_si_units(default_cfg):
     plan = build_plan(default_cfg)
     assert plan.eod_half_separation == pytest.approx(0.005)
     assert plan.sensor_radius == pytest.approx(0.01)
-    # induced moment per field: 4 pi eps0 R^3 chi (SPEC 2.3)
+    # induced moment per field: 4 pi eps0 R^3 chi (docs/model/physics.md#induction)
     eps0 = default_cfg.physics.eps0
     assert plan.alpha_agent == pytest.approx(4 * np.pi * eps0 * 0.01**3 * -0.5, rel=1e-12)
     assert plan.alpha_pellet == pytest.approx(4 * np.pi * eps0 * 0.0025**3 * -0.5, rel=1e-12)

@@ -1,4 +1,4 @@
-"""Distributions, GAE, value normalisation and the recurrent networks (SPEC 9)."""
+"""Distributions, GAE, value normalisation and the recurrent networks (docs/methods/training.md#mappo)."""
 
 from __future__ import annotations
 

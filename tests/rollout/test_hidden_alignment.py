@@ -1,5 +1,6 @@
 """The hidden table's rows are paired with the world they have observed, never with the action they produced
-(decoding rule: sensed variables only, README "Claims"); and the decoding targets the rollout records for that pairing."""
+(decoding rule: sensed variables only, docs/claims/index.md#rule-7); and the decoding targets the rollout records for
+that pairing."""
 
 from __future__ import annotations
 

@@ -1,5 +1,6 @@
 """Scene tables (efish.rollout.scenes, ``efish scene``): field maps against closed-form answers, symmetry,
-insulating walls, the sensing ranges of SPEC 3, and the table schema. Grids are coarse to stay fast."""
+insulating walls, the sensing ranges of docs/model/sensors.md#calibration-checks, and the table schema. Grids are coarse
+to stay fast."""
 
 from __future__ import annotations
 
@@ -29,8 +30,8 @@ def water(table: pd.DataFrame) -> pd.DataFrame:
 
 
 def two_charges(x_cm, y_cm, centre_cm, heading) -> np.ndarray:
-    """The EOD of SPEC 2.1 written out: +q half a separation ahead of the centre, -q behind (V/m), with the
-    softened distance of SPEC 2.4."""
+    """The EOD of docs/model/physics.md#field-sources written out: +q half a separation ahead of the centre, -q behind
+    (V/m), with the softened distance of docs/model/physics.md#field-sources."""
     u = np.array([np.cos(heading), np.sin(heading)]) * PH.eod_half_separation_cm
     p = np.stack([x_cm, y_cm], axis=1)
     e = np.zeros_like(p)
@@ -45,7 +46,8 @@ def test_free_eod_is_two_point_charges_and_a_dipole_far_away():
     e = table[["ex_v_m", "ey_v_m"]].to_numpy()
     exact = two_charges(table["x_cm"].to_numpy(), table["y_cm"].to_numpy(), (20.0, 15.0), 0.0)
     np.testing.assert_allclose(e, exact, rtol=1e-9, atol=1e-18)
-    # beyond 10 cm the pair is a point dipole p = q * separation (SPEC 3.5's on-axis check, every direction)
+    # beyond 10 cm the pair is a point dipole p = q * separation (the on-axis check of
+    # docs/model/sensors.md#calibration-checks, every direction)
     d = (table[["x_cm", "y_cm"]].to_numpy() - (20.0, 15.0)) * 0.01
     r = np.linalg.norm(d, axis=1, keepdims=True)
     far = r[:, 0] >= 0.10
@@ -99,8 +101,8 @@ def test_objects_and_walls_distort_the_field_where_they_are():
 
 
 def test_sensing_ranges_match_spec_calibration():
-    """SPEC 3.3/3.5: Knollenorgans hear a facing, emitting fish to about 100 cm; Mormyromasts detect a pellet
-    ahead to about 5 cm and a fish to about 10 cm."""
+    """Calibration (docs/model/sensors.md#calibration-checks): Knollenorgans hear a facing, emitting fish to about
+    100 cm; Mormyromasts detect a pellet ahead to about 5 cm and a fish to about 10 cm."""
     t = build_scene(compose_scene("sensing_range", ["scene.range_points=48", "scene.bearings=8"]))
     grid = t[t["element"] == "grid"]
     assert set(map(tuple, grid[["variant", "receptor"]].drop_duplicates().to_numpy())) == {

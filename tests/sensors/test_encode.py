@@ -95,8 +95,8 @@ def test_encoder_follows_the_plan_switches(off):
 
 
 def test_noise_uniforms_reproduce_the_four_uniform_calls_of_the_spec():
-    # SPEC 3.4 noise as four Generator.uniform calls (Mormyromast, Ampullary, interference, Knollenorgan):
-    # one rng.random call with low + (high - low) * u gives the same numbers and leaves the same state.
+    # the noise of docs/model/sensors.md#noise as four Generator.uniform calls (Mormyromast, Ampullary, interference,
+    # Knollenorgan): one rng.random call with low + (high - low) * u gives the same numbers and leaves the same state.
     plan = build_plan(cfg_with(), Scene(agents=3))
     raw = random_raw(np.random.default_rng(0), 2, 3, plan, np.float64)
     (lo, hi), (jlo, jhi) = plan.noise_range, plan.interference_range

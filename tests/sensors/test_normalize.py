@@ -1,4 +1,5 @@
-"""Log normalisation, Knollenorgan binarisation and the size channel (SPEC 3.3-3.4)."""
+"""Log normalisation, Knollenorgan binarisation and the size channel (docs/model/sensors.md#normalisation,
+docs/model/sensors.md#knollenorgans)."""
 
 from __future__ import annotations
 

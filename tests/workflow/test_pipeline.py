@@ -341,6 +341,34 @@ def test_a_bad_assay_condition_stops_before_any_job_in_one_line(tmp_path, condit
     assert not (tmp_path / "results").exists()
 
 
+def test_a_new_assay_file_is_built_when_asked_for_without_joining_the_default_target(tmp_path):
+    """One YAML file in config/assay/ asks a new question: its tables are a target at once, with the selected
+    seed, while the default target stays the scale's assays."""
+    shutil.copytree(REPO / "config", tmp_path / "config")
+    (tmp_path / "config/assay/dark.yaml").write_text(
+        "# @package _global_\nassay:\n  name: dark\n  conditions: {control: [], dark: [\"env.muted=[0,1,2,3]\"]}\n")
+    base = ["snakemake", "-n", "--cores", "1", "--snakefile", str(REPO / "Snakefile"), "--directory", str(tmp_path)]
+    asked = subprocess.run([*base, "results/smoke/assays/dark/steps.parquet", "--config", "scale=smoke"],
+                           capture_output=True, text=True, timeout=300, env=smoke_env(tmp_path))
+    assert asked.returncode == 0, asked.stderr[-2000:]
+    assert re.search(r"^assay\s+1$", asked.stdout, re.M) and "assays/dark/steps.parquet" in asked.stdout
+    default = subprocess.run([*base, "--config", "scale=smoke"], capture_output=True, text=True, timeout=300,
+                             env=smoke_env(tmp_path))
+    assert default.returncode == 0 and "assays/dark/" not in default.stdout, default.stderr[-2000:]
+
+
+def test_a_bad_assay_file_outside_the_scale_stops_every_run_in_one_line(tmp_path):
+    shutil.copytree(REPO / "config", tmp_path / "config")
+    (tmp_path / "config/assay/draft.yaml").write_text(
+        "# @package _global_\nassay:\n  name: draft\n  conditions: {control: [\"env.nonsense=1\"]}\n")
+    result = subprocess.run(["snakemake", "-n", "--cores", "1", "--snakefile", str(REPO / "Snakefile"),
+                             "--directory", str(tmp_path), "--config", "scale=smoke"],
+                            capture_output=True, text=True, timeout=300, env=smoke_env(tmp_path))
+    last = result.stderr.strip().splitlines()[-1]
+    assert result.returncode != 0 and last.startswith("efish workflow: assay draft"), result.stderr[-2000:]
+    assert "unknown config key 'env.nonsense'" in last
+
+
 @pytest.mark.slow
 def test_a_run_override_reaches_every_drawing(smoke_run, tmp_path):
     """env.fps on the command line and other one-patch sizes in the assay file: Fig 3's EOD-rate axis (Hz) and

@@ -17,7 +17,7 @@ rule assay:
         out=folder_of("steps"),
         policies=policy_args,
     wildcard_constraints:
-        assay="|".join(a for a in ASSAYS if a not in HIDDEN_ASSAYS) or "^$",
+        assay="|".join(BUILDABLE_ASSAYS[False]) or "^$",
     conda:
         "../envs/efish.yaml"
     shell:
@@ -28,7 +28,7 @@ use rule assay as assay_with_hidden with:
     output:
         **assay_outputs(hidden=True),
     wildcard_constraints:
-        assay="|".join(HIDDEN_ASSAYS) or "^$",
+        assay="|".join(BUILDABLE_ASSAYS[True]) or "^$",
 
 
 # The best-ranked seeds (scale.top_seeds, from the select_seed checkpoint's ranking) rerun assays with their own

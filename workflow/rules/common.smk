@@ -85,6 +85,10 @@ def assay_config(name):
 
 
 ASSAYS = [assay_config(name).assay.name for name in CFG.scale.assays]
+# Every other assay file in config/assay/: not in the default target, but its tables are built when asked for
+# (snakemake results/<run>/assays/<name>/steps.parquet), so a new question is one YAML file. Checked like the
+# scale's assays: a file that does not compose stops every run, in one line naming it.
+ASKED_ASSAYS = sorted(p.stem for p in (config_dir() / "assay").glob("*.yaml") if p.stem not in ASSAYS)
 POLICY_RECIPES = sorted(p.stem for p in (config_dir() / "policy").glob("*.yaml"))
 
 
@@ -109,13 +113,13 @@ def checked_assays():
     """``assay_policies`` of every assay, cached in .snakemake/efish/ under a hash of the config tree, the efish
     sources, the scale and the overrides: composing every condition costs seconds, and each Snakemake call
     (each cluster job too) reads this file again."""
-    digest = hashlib.sha256(repr((SCALE, OVERRIDES, ASSAYS, source_digest())).encode())
+    digest = hashlib.sha256(repr((SCALE, OVERRIDES, ASSAYS, ASKED_ASSAYS, source_digest())).encode())
     for path in sorted(config_dir().rglob("*.yaml")):
         digest.update(path.read_bytes())
     cache = Path(".snakemake/efish") / f"assays-{digest.hexdigest()[:16]}.json"
     if cache.is_file():
         return json.loads(cache.read_text())
-    checked = {name: assay_policies(name) for name in ASSAYS}
+    checked = {name: assay_policies(name) for name in [*ASSAYS, *ASKED_ASSAYS]}
     cache.parent.mkdir(parents=True, exist_ok=True)
     cache.write_text(json.dumps(checked))
     return checked
@@ -123,6 +127,9 @@ def checked_assays():
 
 ASSAY_POLICIES = checked_assays()
 HIDDEN_ASSAYS = [name for name in ASSAYS if assay_config(name).assay.record_hidden]
+# What the assay rules may build, split by whether the assay records hidden states (assay_with_hidden).
+BUILDABLE_ASSAYS = {hidden: [name for name in [*ASSAYS, *ASKED_ASSAYS]
+                             if assay_config(name).assay.record_hidden == hidden] for hidden in (False, True)}
 # The analyses of each assay of the scale whose tables it writes (dynamics waits for assay.record_hidden).
 ASSAY_ANALYSES = {name: analyses_for(name, tables_written(assay_config(name).assay)) for name in ASSAYS}
 DRAWABLE = drawable(CFG.scale)

@@ -1,1 +1,1 @@
-"""Pure functions on rollout tables; no torch, no simulator (DESIGN)."""
+"""Pure functions on rollout tables; no torch, no simulator (docs/architecture.md)."""

@@ -13,12 +13,12 @@ import pandas as pd
 
 from ..config.schema import AnalysisConfig, EnvConfig
 
-#: The schema's analysis parameters (SPEC 12): the keyword defaults of the analysis functions, so that a
-#: function called by hand and ``efish analyze`` (which passes the composed config's values) agree.
+#: The schema's analysis parameters (docs/methods/analyses.md): the keyword defaults of the analysis functions, so that
+#: a function called by hand and ``efish analyze`` (which passes the composed config's values) agree.
 DEFAULTS = AnalysisConfig()
 #: Steps per second (``env.fps``, 83), the factor from an EOD probability per step to a rate in Hz.
 RATE_HZ = EnvConfig().fps
-#: ms per simulation step: dt = 1 / fps (SPEC "Units"), i.e. 12.048 ms.
+#: ms per simulation step: dt = 1 / fps (docs/model/environment.md#step-order), i.e. 12.048 ms.
 STEP_MS = 1000.0 / RATE_HZ
 
 EPISODE = ["condition", "episode"]
@@ -49,7 +49,8 @@ def or_nan_row(frame: pd.DataFrame, reason: str) -> pd.DataFrame:
 
 
 def eod_rate(steps: pd.DataFrame, window: int = DEFAULTS.rate_window, rate_hz: float = RATE_HZ) -> np.ndarray:
-    """Centred rolling mean of ``eod`` over ``window`` steps x ``rate_hz`` per agent-episode (SPEC 12), in Hz.
+    """Centred rolling mean of ``eod`` over ``window`` steps x ``rate_hz`` per agent-episode
+    (docs/methods/analyses.md#analysis-signalling), in Hz.
 
     Only full windows count, so the first and last ``window // 2`` steps of an
     episode are NaN rather than biased by a shorter window. Row-aligned with ``steps``.

@@ -1,4 +1,5 @@
-"""Foraging and social behaviour (SPEC 12; Figs 3, 4, 5): food, inequality, dominance, bites, spacing, reach.
+"""Foraging and social behaviour (docs/methods/analyses.md#analysis-behaviour; Figs 3, 4, 5): food, inequality,
+dominance, bites, spacing, reach.
 
 Inputs are the rollout tables: ``episodes`` (one row per agent-episode) and
 ``steps`` (one row per agent-step). Tables of statistics use the columns of
@@ -16,7 +17,7 @@ from .inequality import theil_t, win_ratio
 from .selection import ols_fit
 from .stats import STAT_COLUMNS, stars
 
-#: Centre of the one-patch arena's patch (150 x 150 cm, SPEC 8) and its radius.
+#: Centre of the one-patch arena's patch (150 x 150 cm, docs/model/environment.md#arenas-and-food) and its radius.
 ONE_PATCH_XY_CM = (75.0, 75.0)
 ONE_PATCH_RADIUS_CM = 6.0
 
@@ -67,7 +68,8 @@ def food_vs_size(episodes: pd.DataFrame) -> pd.DataFrame:
 
 
 def food_vs_size_per_episode(episodes: pd.DataFrame) -> pd.DataFrame:
-    """Slope, intercept and R^2 of food_eaten ~ size over each episode's agents (the seed-selection fit, SPEC 10)."""
+    """Slope, intercept and R^2 of food_eaten ~ size over each episode's agents (the seed-selection fit,
+    docs/methods/training.md#seed-selection)."""
     require(episodes, [*EPISODE, "size", "food_eaten"], "episodes table")
     rows = []
     for (cond, ep), sub in episodes.groupby(EPISODE, sort=True):
@@ -210,7 +212,8 @@ def reach_times(steps: pd.DataFrame, patch_xy_cm: tuple[float, float] = ONE_PATC
     """First step at which each agent's centre is within ``reach_cm`` of the patch centre, per agent-episode.
 
     Defaults: the one-patch arena's patch (centre of 150 x 150 cm, radius 6 cm,
-    SPEC 8). ``reached`` is False and ``t_reach`` NaN for an agent that never got there.
+    docs/model/environment.md#arenas-and-food). ``reached`` is False and
+    ``t_reach`` NaN for an agent that never got there.
     """
     require(steps, [*AGENT_EPISODE, "t", "x_cm", "y_cm"], "steps table")
     d = np.hypot(steps["x_cm"].to_numpy(np.float64) - patch_xy_cm[0],
@@ -244,5 +247,6 @@ def reach_rates(steps: pd.DataFrame, patch_xy_cm: tuple[float, float] = ONE_PATC
 
 def bot_reach_rates(steps: pd.DataFrame, agent: int = 1, patch_xy_cm: tuple[float, float] = ONE_PATCH_XY_CM,
                     reach_cm: float = ONE_PATCH_RADIUS_CM) -> pd.DataFrame:
-    """Reach rate of the trained agent (``agent``, B) per bot condition (Fig 5I,J; the bot is agent 0, SPEC 11)."""
+    """Reach rate of the trained agent (``agent``, B) per bot condition (Fig 5I,J; the bot is agent 0,
+    docs/methods/assays.md#assay-bot)."""
     return reach_rates(steps, patch_xy_cm, reach_cm, agent=agent)

@@ -1,23 +1,24 @@
 """Building blocks of :mod:`efish.analysis.claims`: a claim's tested parts, their verdicts, the bootstrap.
 
-A claim of CLAIMS.md often says several things at once (C10: two ablations cut
-food, a third keeps it and raises EOD probability...). Each thing is one
-:class:`Part`: an effect with the paper's sign, a p-value, an n, a bootstrap
-interval and a verdict; :func:`combine` makes the claim's one row of them and
-:func:`part_rows` a row per part (``claim_parts.parquet``, which keeps each
-part's effect and interval, e.g. to follow them along training).
+A claim of the paper (docs/claims/index.md) often says several things at once
+(C10: two ablations cut food, a third keeps it and raises EOD probability...).
+Each thing is one :class:`Part`: an effect with the paper's sign, a p-value, an
+n, a bootstrap interval and a verdict; :func:`combine` makes the claim's one row
+of them and :func:`part_rows` a row per part (``claim_parts.parquet``, which
+keeps each part's effect and interval, e.g. to follow them along training).
 
-Verdicts (CLAIMS.md): **holds** = the paper's sign and p < alpha; **weaker** =
-the paper's sign but not significant (an effect of the opposite sign that is not
-significant is also weaker: nothing refutes the claim, and the reason says so);
-**fails** = the opposite sign and significant, or a criterion that cannot hold;
-**not decidable** = the data cannot carry the test (a condition at a ceiling
-or floor), with the reason; **not run** = no table or no testable data, with
-the reason. A part the paper reports as *no difference* (K-off food in C10)
-holds when it is *shown equivalent*: its two one-sided tests (TOST) within the
-part's margin give p < alpha; it fails when the difference is significant and
-larger than the margin; otherwise it is weaker. Every difference test here is
-two-sided, so that an effect of the opposite sign can be significant.
+Verdicts (docs/claims/index.md#verdicts): **holds** = the paper's sign and
+p < alpha; **weaker** = the paper's sign but not significant (an effect of the
+opposite sign that is not significant is also weaker: nothing refutes the claim,
+and the reason says so); **fails** = the opposite sign and significant, or a
+criterion that cannot hold; **not decidable** = the data cannot carry the test
+(a condition at a ceiling or floor), with the reason; **not run** = no table or
+no testable data, with the reason. A part the paper reports as *no difference*
+(K-off food in C10) holds when it is *shown equivalent*: its two one-sided tests
+(TOST) within the part's margin give p < alpha; it fails when the difference is
+significant and larger than the margin; otherwise it is weaker. Every difference
+test here is two-sided, so that an effect of the opposite sign can be
+significant.
 
 A part may be reported *beside* a claim without deciding it (``decides=False``,
 e.g. the Methods' 4-agent mute design beside the Results' 2-agent one): its
@@ -380,7 +381,8 @@ class Context:
 
 @dataclass(frozen=True)
 class Claim:
-    """A claim of the paper (README "Claims"): id, figure panels, the tables it reads, and its function (tables, cfg) -> its parts.
+    """A claim of the paper (docs/claims/index.md): id, figure panels, the tables it reads, and its function (tables,
+    cfg) -> its parts.
 
     :meth:`assess` gives the claim's row and its parts from one computation; :meth:`run` the row alone.
     """

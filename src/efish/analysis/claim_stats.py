@@ -1,4 +1,4 @@
-"""The statistics the claims' revised rules need (README, "Claims") that no analysis table holds.
+"""The statistics the claims' revised rules need (docs/claims/index.md) that no analysis table holds.
 
 - :func:`paired_vs_control`: every condition against a control, paired over
   the episodes they share (Wilcoxon signed-rank), Holm-corrected over the

@@ -1,4 +1,4 @@
-"""The paper's claims as verdicts (CLAIMS.md): one function per claim C1..C21, a registry, the claims table.
+"""The paper's claims as verdicts (docs/claims/index.md): one function per claim C1..C21, a registry, the claims table.
 
 Each claim function takes the tables it names (a dict keyed by the path under
 ``results/{run}/``, e.g. ``analysis/homing/homing/trajectory_shape.parquet``)
@@ -222,8 +222,8 @@ def c5(ctx: Context) -> list[Part]:
         eta, p, n = _kruskal_eta(per)
         reason = "" if np.isfinite(p) else "fewer than 2 distance bins with data, or a constant rate"
         return Outcome(eta, p, n, None, ctx.ci(per, lambda d: _kruskal_eta(d)[0]), reason)
-    stat = ("Kruskal-Wallis of the mean EOD rate per agent-episode and distance bin across the SPEC 12 bins "
-            "(wide2); effect epsilon^2")
+    stat = ("Kruskal-Wallis of the mean EOD rate per agent-episode and distance bin across the bins of "
+            "docs/methods/analyses.md#analysis-signalling (wide2); effect epsilon^2")
     return [ctx.part(to, stat, functools.partial(compute, to)) for to in ("agent", "food", "wall")]
 
 

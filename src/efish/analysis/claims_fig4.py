@@ -6,7 +6,7 @@ share their episode seeds, so they are compared paired over episodes with a
 Holm correction over the conditions compared with the same control; "no
 difference" parts are equivalence tests; food parts are not decidable while
 the control eats every pellet; Theil T is compared above its equal-share null
-where totals differ (the rules are listed in the README, "Claims").
+where totals differ (the rules: docs/claims/index.md).
 
 Condition names are those of ``config/assay/<assay>.yaml``.
 """

@@ -30,7 +30,7 @@ def _effects(table: pd.DataFrame) -> list[str]:
 def claims_markdown(table: pd.DataFrame, header: str, trends: Mapping[str, str] | None = None) -> str:
     """The claims table as markdown under a ``header`` line: claim, panel, statistic, effect [95% CI], n, p, verdict,
     seeds_agree (when the table has it: the verdicts across the top seeds, :mod:`efish.analysis.claims_seeds`),
-    reason (what the README quotes and the Snakemake report shows); with ``trends`` (claim -> line,
+    reason (what docs/claims/results.md quotes and the Snakemake report shows); with ``trends`` (claim -> line,
     :func:`efish.analysis.claims_stages.trend_lines`) the section :func:`along_training` after it."""
     shown = pd.DataFrame({
         "claim": table["claim"], "panel": table["panel"], "statistic": table["statistic"],

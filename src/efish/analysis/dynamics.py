@@ -1,4 +1,5 @@
-"""Hidden-state dynamics (SPEC 12; Fig 6): dimensionality, decoding, shared dimensions (PLSC), power.
+"""Hidden-state dynamics (docs/methods/analyses.md#analysis-dynamics; Fig 6): dimensionality, decoding, shared
+dimensions (PLSC), power.
 
 Functions on matrices take a T x D array ``h`` (time x units, e.g. one
 agent-episode of the ``hidden`` table, see :func:`hidden_matrix`). Scalar
@@ -21,15 +22,16 @@ from sklearn.model_selection import GroupKFold, cross_val_predict
 from ._tables import AGENT_EPISODE, DEFAULTS, EPISODE, RATE_HZ, nan_frame, require
 
 SUBSAMPLE_FRACTIONS = tuple(DEFAULTS.subsample_fractions)
-#: Steps columns of the world the hidden state has observed (README "Tables", Fig 6E's sensed
-#: variables) -> circular (radians) or not: the only competitors when decoding scores are ranked (claim C19).
-#: Each describes the world after step t, which the hidden row t has taken in (efish.rollout.run.hidden_table).
+#: Steps columns of the world the hidden state has observed (docs/reference/tables.md; Fig 6E's sensed
+#: variables, docs/methods/analyses.md#decoding-variables) -> circular (radians) or not: the only competitors when
+#: decoding scores are ranked (claim C19). Each describes the world after step t, which the hidden row t has taken in
+#: (efish.rollout.run.hidden_table).
 SENSED_TARGETS = {"dist_agent_cm": False, "n_agents_100cm": False, "log_morm_sensed": False, "dist_wall_cm": False,
                   "bearing_agent_rad": True, "dist_agent2_cm": False, "size_agent1": False, "size_agent2": False,
                   "dist_food_cm": False, "bearing_food_rad": True, "bearing_wall_rad": True,
                   "food_count_5cm": False, "log_amp_field": False}
-#: Steps columns that are readouts of the policy itself, not sensing (README, "Claims"): its own outputs of step t
-#: (the realised turn, the EOD: produced by the state before row t's, and fed back to row t's state through the
+#: Steps columns that are readouts of the policy itself, not sensing (docs/claims/index.md#rule-7): its own outputs of
+#: step t (the realised turn, the EOD: produced by the state before row t's, and fed back to row t's state through the
 #: observation's last-action tail) and the agent's own size, a per-agent constant of every observation. Decoded and
 #: reported, never ranked among the sensed targets.
 READOUT_TARGETS = {"turn_rad": False, "eod": False, "size": False}
@@ -77,7 +79,8 @@ def pca_variances(h: np.ndarray) -> np.ndarray:
 
 
 def effective_dimensionality(h: np.ndarray) -> float:
-    """D_eff = 1 / sum(lambda_i^2) of the normalised PCA variances lambda_i (SPEC 12); NaN when degenerate.
+    """D_eff = 1 / sum(lambda_i^2) of the normalised PCA variances lambda_i
+    (docs/methods/analyses.md#analysis-dynamics); NaN when degenerate.
 
     >>> rng = np.random.default_rng(0)
     >>> round(effective_dimensionality(np.outer(rng.normal(size=50), [1.0, 2.0, 3.0])), 6)
@@ -88,7 +91,8 @@ def effective_dimensionality(h: np.ndarray) -> float:
 
 
 def pcs_for_variance(h: np.ndarray, fraction: float = DEFAULTS.variance_fraction) -> float:
-    """Fewest principal components whose variances add up to ``fraction`` (SPEC 12: 90%); NaN if degenerate."""
+    """Fewest principal components whose variances add up to ``fraction`` (90%,
+    docs/methods/analyses.md#analysis-dynamics); NaN if degenerate."""
     lam = pca_variances(h)
     if not lam.size:
         return np.nan
@@ -98,7 +102,8 @@ def pcs_for_variance(h: np.ndarray, fraction: float = DEFAULTS.variance_fraction
 
 def subsample_units(h: np.ndarray, fractions=SUBSAMPLE_FRACTIONS, draws: int = DEFAULTS.subsample_draws,
                     rng: np.random.Generator | int | None = None) -> pd.DataFrame:
-    """D_eff of random subsets of units (SPEC 12: fractions .05 .15 .25 .5 .75 1, 30 draws each), Fig 6C.
+    """D_eff of random subsets of units (fractions .05 .15 .25 .5 .75 1, 30 draws each;
+    docs/methods/analyses.md#analysis-dynamics), Fig 6C.
 
     Each draw keeps round(fraction x D) units (at least 1) without replacement.
     Columns: fraction, n_units, draw, d_eff, reason.
@@ -117,7 +122,8 @@ def subsample_units(h: np.ndarray, fractions=SUBSAMPLE_FRACTIONS, draws: int = D
 
 def wideband_power(h: np.ndarray, window: int = DEFAULTS.spectrogram_window,
                    overlap: int = DEFAULTS.spectrogram_overlap, fs: float = RATE_HZ) -> float:
-    """Mean spectrogram power over units, windows and frequencies (SPEC 12: 20-step windows, 10 overlap).
+    """Mean spectrogram power over units, windows and frequencies (20-step windows, 10 overlap;
+    docs/methods/analyses.md#analysis-dynamics).
 
     scipy.signal.spectrogram with its defaults otherwise (Tukey window,
     constant detrend, power spectral density at sampling rate ``fs``); NaN when
@@ -146,7 +152,8 @@ def dynamics_table(hidden: pd.DataFrame, fraction: float = DEFAULTS.variance_fra
 
 def decode(x: np.ndarray, y: np.ndarray, groups: np.ndarray, circular: bool = False,
            folds: int = DEFAULTS.decode_folds) -> dict:
-    """Cross-validated linear readout of ``y`` from ``x`` (SPEC 12 "Decoding"), folds grouped by episode.
+    """Cross-validated linear readout of ``y`` from ``x``, folds grouped by episode
+    (docs/methods/analyses.md#analysis-dynamics).
 
     OLS (sklearn LinearRegression) under GroupKFold(``folds``) over ``groups``
     (so no episode is in both train and test), pooled out-of-fold predictions;
@@ -198,7 +205,8 @@ def _plsc_spectrum(za: np.ndarray, zb: np.ndarray, k: int) -> tuple[np.ndarray, 
 
 def plsc(h_a: np.ndarray, h_b: np.ndarray, shifts: int = DEFAULTS.plsc_shifts,
          rng: np.random.Generator | int | None = None, percentile: float = DEFAULTS.plsc_percentile) -> dict:
-    """Partial least squares correlation of two agents' hidden states with a circular-shift null (SPEC 12).
+    """Partial least squares correlation of two agents' hidden states with a circular-shift null
+    (docs/methods/analyses.md#analysis-dynamics).
 
     Both T x D matrices are z-scored per unit; the SVD of their
     cross-covariance gives singular values and paired components. The null
@@ -234,7 +242,8 @@ def plsc(h_a: np.ndarray, h_b: np.ndarray, shifts: int = DEFAULTS.plsc_shifts,
 def plsc_by_distance(h_a: np.ndarray, h_b: np.ndarray, dist_cm: np.ndarray, edges_cm=tuple(DEFAULTS.plsc_edges_cm),
                      shifts: int = DEFAULTS.plsc_shifts, rng: np.random.Generator | int | None = None,
                      percentile: float = DEFAULTS.plsc_percentile) -> pd.DataFrame:
-    """:func:`plsc` on the steps whose inter-agent distance falls in each bin (SPEC 12: <= 10, 10-100, > 100 cm).
+    """:func:`plsc` on the steps whose inter-agent distance falls in each bin (<= 10, 10-100, > 100 cm;
+    docs/methods/analyses.md#analysis-dynamics).
 
     The steps of a bin are taken in time order and the null shifts them as one
     series. One row per bin: ``lo_cm``, ``hi_cm`` (bins are (lo, hi], the first

@@ -1,4 +1,5 @@
-"""Tests on the hidden-state dynamics (SPEC 12; Fig 6B, I, J): D_eff against group size, wideband power by context.
+"""Tests on the hidden-state dynamics (docs/methods/analyses.md#analysis-dynamics; Fig 6B, I, J): D_eff against group
+size, wideband power by context.
 
 The dynamics analysis writes them as statistic tables (columns of
 :data:`efish.analysis.stats.STAT_COLUMNS` plus ``measure``): ``size_tests``

@@ -1,4 +1,4 @@
-"""Homing (SPEC 11 homing assay; Fig 2B-D): error angles and trajectory shape, electric vs ray-casting.
+"""Homing (docs/methods/assays.md#assay-homing; Fig 2B-D): error angles and trajectory shape, electric vs ray-casting.
 
 The rollout writes, per homer step, the error angle between its heading and
 the local direction of the target's field seen by each receptor class

@@ -1,4 +1,4 @@
-"""Inequality and dominance measures (SPEC 12)."""
+"""Inequality and dominance measures (docs/methods/analyses.md#analysis-behaviour)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,5 @@
-"""Pairwise interactions (SPEC 12 "Interactions"; Fig 5K-P): per-step labels, bouts, chases and bites.
+"""Pairwise interactions (docs/methods/analyses.md#analysis-interactions; Fig 5K-P): per-step labels, bouts, chases and
+bites.
 
 Per step and ordered pair (agent i, partner j), ``a_i`` is i's heading minus
 its bearing to j, wrapped to [-pi, pi); i *faces* j when |a_i| <= pi/4 and
@@ -47,7 +48,8 @@ def _labels(p: pd.DataFrame, facing_rad: float, away_rad: float) -> np.ndarray:
 
 def label_steps(steps: pd.DataFrame, facing_rad: float = DEFAULTS.facing_rad, away_rad: float = DEFAULTS.away_rad,
                 within_cm: float | None = None) -> pd.DataFrame:
-    """Label every ordered pair of agents at every step (module docstring; SPEC 12 thresholds pi/4, 3 pi/4).
+    """Label every ordered pair of agents at every step (module docstring; thresholds pi/4, 3 pi/4 of
+    docs/methods/analyses.md#analysis-interactions).
 
     Needs only condition, episode, t, agent, x_cm, y_cm, heading_rad. Returns
     condition, episode, t, agent, partner, ``dist_cm`` and ``label``; with

@@ -1,4 +1,5 @@
-"""The one-patch intruder and bot assays (README "Assays"; Fig 5E-J): who is A and who is B, and the tests by role.
+"""The one-patch intruder and bot assays (docs/methods/assays.md; Fig 5E-J): who is A and who is B, and the tests by
+role.
 
 Who is who comes from the conditions the run recorded (``assays/<assay>/conditions.parquet``, read back with
 :func:`efish.config.recorded.recorded_conditions`), never from the condition names, so an assay file or a run

@@ -69,7 +69,8 @@ DYNAMICS_MEASURES = ["d_eff", "pcs_for_variance", "wideband_power"]
 
 @dataclass(frozen=True)
 class Analysis:
-    """One analysis: its compute function, the rollout tables it reads, its SPEC 11 assays and output tables."""
+    """One analysis: its compute function, the rollout tables it reads, its assays (docs/methods/assays.md) and output
+    tables."""
 
     name: str
     compute: Callable[[Tables, EfishConfig], Tables]

@@ -1,4 +1,4 @@
-"""Seed selection by an ethological criterion (SPEC 10).
+"""Seed selection by an ethological criterion (docs/methods/training.md#seed-selection).
 
 Per seed, from its evaluation episodes: mean total food per episode, and the
 median over episodes of slope, intercept and R^2 of the OLS fit
@@ -33,7 +33,8 @@ def ols_fit(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
 
 
 def seed_statistics(episodes: pd.DataFrame) -> pd.DataFrame:
-    """One row per seed from an episodes table with a ``seed`` column (SPEC 10 statistics)."""
+    """One row per seed from an episodes table with a ``seed`` column (the statistics of
+    docs/methods/training.md#seed-selection)."""
     required = {"seed", "episode", "size", "food_eaten"}
     if missing := required - set(episodes.columns):
         raise ValueError(f"episodes table lacks columns {sorted(missing)}")
@@ -90,7 +91,8 @@ def read_seed_episodes(paths: Iterable[str | Path]) -> pd.DataFrame:
 
 
 def select_seed(paths: Iterable[str | Path]) -> tuple[pd.DataFrame, int]:
-    """SPEC 10 on the episodes tables at ``paths``: the full ranking table and the chosen seed."""
+    """Seed selection (docs/methods/training.md#seed-selection) on the episodes tables at ``paths``: the full ranking
+    table and the chosen seed."""
     table = rank_seeds(seed_statistics(read_seed_episodes(paths)))
     return table, int(table.loc[table["selected"], "seed"].iloc[0])
 

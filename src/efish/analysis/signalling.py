@@ -1,4 +1,5 @@
-"""EOD signalling (SPEC 12 "IDI", "EOD rate"): inter-discharge intervals, power laws, EOD rate vs context.
+"""EOD signalling (docs/methods/analyses.md#analysis-signalling): inter-discharge intervals, power laws, EOD rate vs
+context.
 
 The EOD rate of a step is the 20-step centred rolling mean of ``eod`` times
 83 Hz, computed per agent-episode. Rates are binned against distances,
@@ -26,7 +27,8 @@ from ._tables import (
     require,
 )
 
-#: Distance column and default binning range (cm) per ``to`` of :func:`eod_rate_by_distance` (SPEC 12).
+#: Distance column and default binning range (cm) per ``to`` of :func:`eod_rate_by_distance`
+#: (docs/methods/analyses.md#analysis-signalling).
 DISTANCE_RANGES_CM = {to: (0.0, getattr(DEFAULTS, f"{to}_range_cm")) for to in ("agent", "food", "wall")}
 #: Event columns :func:`peri_event_rate` aligns on: eating, biting, being bitten.
 EVENTS = ("ate", "bit", "was_bitten")
@@ -36,7 +38,8 @@ def idis(steps: pd.DataFrame, step_ms: float = STEP_MS) -> pd.DataFrame:
     """One row per inter-discharge interval: the step difference of consecutive EODs of an agent-episode.
 
     Columns: condition, episode, agent, t (step of the later discharge),
-    ``idi_steps`` and ``idi_ms`` = ``idi_steps`` x ``step_ms`` (12.048 ms, SPEC 12).
+    ``idi_steps`` and ``idi_ms`` = ``idi_steps`` x ``step_ms`` (12.048 ms,
+    docs/methods/analyses.md#analysis-signalling).
     """
     require(steps, [*AGENT_EPISODE, "t", "eod"], "steps table")
     fired = steps.loc[steps["eod"].astype(bool), [*AGENT_EPISODE, "t"]].sort_values([*AGENT_EPISODE, "t"])
@@ -48,7 +51,8 @@ def idis(steps: pd.DataFrame, step_ms: float = STEP_MS) -> pd.DataFrame:
 
 def idi_histogram(idi_ms, bins: int = DEFAULTS.idi_bins, lo_ms: float = DEFAULTS.idi_lo_ms,
                   hi_ms: float = DEFAULTS.idi_hi_ms) -> pd.DataFrame:
-    """Counts and density of IDIs on ``bins`` log-spaced bins over [``lo_ms``, ``hi_ms``] (SPEC 12).
+    """Counts and density of IDIs on ``bins`` log-spaced bins over [``lo_ms``, ``hi_ms``]
+    (docs/methods/analyses.md#analysis-signalling).
 
     The density is per ms, so histograms with different bin widths compare.
     """
@@ -106,7 +110,7 @@ def xmin_in_steps(xmin_ms: float, step_ms: float = STEP_MS) -> int:
 def load_real_idis(path: str | Path | None) -> pd.DataFrame:
     """Real-fish IDIs (ms) from a user-supplied CSV or Parquet file with an ``idi_ms`` column.
 
-    The recordings are not public (SPEC D), so ``path`` is unset by default
+    The recordings are not public (docs/model/differences.md), so ``path`` is unset by default
     (config ``analysis.real_fish_idis``); the result is then one NaN row whose
     ``reason`` says so, and a fit or a panel reports it instead of failing.
     """
@@ -142,7 +146,7 @@ def eod_rate_by_distance(steps: pd.DataFrame, to: str, bins: int = DEFAULTS.rate
                          window: int = DEFAULTS.rate_window, rate_hz: float = RATE_HZ) -> pd.DataFrame:
     """Mean +- SEM EOD rate (Hz) in ``bins`` equal distance bins to the nearest ``to`` (agent, food or wall).
 
-    Ranges default to SPEC 12: 0-150 cm for agents, 0-10 cm for food and wall.
+    Ranges default to docs/methods/analyses.md#analysis-signalling: 0-150 cm for agents, 0-10 cm for food and wall.
     Samples are steps (every agent-step with a full rate window), per condition;
     bins with fewer than ``min_samples`` steps are dropped. A condition with no
     bin left gets one NaN row with a reason.
@@ -175,7 +179,8 @@ def _event_triggered(rate: np.ndarray, events: np.ndarray, lags: np.ndarray) -> 
 def peri_event_rate(steps: pd.DataFrame, event: str, window: int = DEFAULTS.peri_window,
                     min_events: int = DEFAULTS.min_events, rate_window: int = DEFAULTS.rate_window,
                     rate_hz: float = RATE_HZ) -> pd.DataFrame:
-    """Mean +- SEM EOD rate (Hz) from ``window`` steps before to ``window`` after an ``event`` (SPEC 12).
+    """Mean +- SEM EOD rate (Hz) from ``window`` steps before to ``window`` after an ``event``
+    (docs/methods/analyses.md#analysis-signalling).
 
     ``event`` is a boolean steps column: ``ate``, ``bit`` or ``was_bitten``.
     Each agent-episode with at least ``min_events`` events contributes its mean

@@ -1,4 +1,5 @@
-"""Statistical tests as tidy rows (SPEC 12 "Tests"): Dunnett vs control, Mann-Whitney, Wilcoxon, Spearman, Fisher.
+"""Statistical tests as tidy rows (docs/methods/analyses.md): Dunnett vs control, Mann-Whitney, Wilcoxon, Spearman,
+Fisher.
 
 Every function returns one row per comparison with the columns of
 ``STAT_COLUMNS``: which ``test``, the ``group`` and the ``control`` it is

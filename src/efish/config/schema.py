@@ -40,7 +40,7 @@ def group(cls: type) -> Any:
 # --------------------------------------------------------------------- physics
 @dataclass
 class PhysicsConfig:
-    """Field sources, walls and the accuracy knobs of the field computation (SPEC 2)."""
+    """Field sources, walls and the accuracy knobs of the field computation (docs/model/physics.md#field-sources)."""
 
     eps0: float = param(8.854e-12, "vacuum permittivity, F/m", lo=0.0)
     eod_charge_c: float = param(1.11e-15, "EOD monopole charge q, C", lo=0.0)
@@ -71,7 +71,7 @@ class PhysicsConfig:
 # --------------------------------------------------------------------- sensors
 @dataclass
 class MormyromastConfig:
-    """Active electroreceptors: distortions of EOD fields (SPEC 3.1)."""
+    """Active electroreceptors: distortions of EOD fields (docs/model/sensors.md#mormyromasts)."""
 
     enabled: bool = param(True, "compute and report this receptor class")
     count: int = param(36, "number of sensors", lo=1, hi=1024)
@@ -87,7 +87,7 @@ class MormyromastConfig:
 
 @dataclass
 class AmpullaryConfig:
-    """Passive electroreceptors: intrinsic fields of bodies (SPEC 3.2)."""
+    """Passive electroreceptors: intrinsic fields of bodies (docs/model/sensors.md#ampullary-organs)."""
 
     enabled: bool = param(True, "compute and report this receptor class")
     count: int = param(24, "number of sensors, evenly spaced from the heading", lo=1, hi=1024)
@@ -97,7 +97,7 @@ class AmpullaryConfig:
 
 @dataclass
 class KnollenorganConfig:
-    """Conspecific-EOD receptors, binarised per slot (SPEC 3.3)."""
+    """Conspecific-EOD receptors, binarised per slot (docs/model/sensors.md#knollenorgans)."""
 
     enabled: bool = param(True, "compute and report this receptor class")
     count: int = param(12, "sensors per conspecific slot, evenly spaced", lo=1, hi=1024)
@@ -109,7 +109,7 @@ class KnollenorganConfig:
 
 @dataclass
 class NoiseConfig:
-    """Multiplicative sensor noise (SPEC 3.4)."""
+    """Multiplicative sensor noise (docs/model/sensors.md#noise)."""
 
     enabled: bool = param(True, "multiply raw readings by uniform noise")
     low: float = param(0.95, "lower factor for every raw reading", lo=0.0)
@@ -120,7 +120,7 @@ class NoiseConfig:
 
 @dataclass
 class SensorsConfig:
-    """Receptor classes, their layout, ranges, gates and noise (SPEC 3)."""
+    """Receptor classes, their layout, ranges, gates and noise (docs/model/sensors.md)."""
 
     perception: str = param("electric", "electric fields or the ray-casting baseline", choices=("electric", "raycast"))
     mormyromast: MormyromastConfig = group(MormyromastConfig)
@@ -134,8 +134,8 @@ class SensorsConfig:
 # ----------------------------------------------------------------------- arena
 @dataclass
 class ArenaConfig:
-    """Arena size and food layout (SPEC 8). ``layout=training`` samples size, layout and
-    food multiplier per episode from the ``train_*`` fields."""
+    """Arena size and food layout (docs/model/environment.md#arenas-and-food). ``layout=training`` samples size, layout
+    and food multiplier per episode from the ``train_*`` fields."""
 
     layout: str = param("patchy", "food layout",
                         choices=("patchy", "uniform", "npatch", "onepatch", "training", "none"))
@@ -172,7 +172,8 @@ class ArenaConfig:
 # ------------------------------------------------------------------------- env
 @dataclass
 class EnvConfig:
-    """Bodies, motion, eating, biting, rewards and interventions of the foraging task (SPEC 1, 4-7)."""
+    """Bodies, motion, eating, biting, rewards and interventions of the foraging task (docs/model/physics.md#bodies,
+    docs/model/environment.md)."""
 
     n_agents: int = param(4, "agents per environment", lo=1, hi=16)
     obs_agents: int = param(4, "observation layout is sized for this many agents (unused slots are 0)", lo=1, hi=16)
@@ -224,9 +225,9 @@ class EnvConfig:
 # ----------------------------------------------------------------------- train
 @dataclass
 class TrainConfig:
-    """Recurrent MAPPO (README "Training"). The sizes (hidden, epochs, num_envs, rollout_steps, chunk, total_steps) read the
-    scale by interpolation, so their one copy is in :class:`ScaleConfig` and config/scale/*.yaml; a resolved
-    config (:func:`~efish.config.compose`) holds numbers."""
+    """Recurrent MAPPO (docs/methods/training.md#mappo). The sizes (hidden, epochs, num_envs, rollout_steps, chunk,
+    total_steps) read the scale by interpolation, so their one copy is in :class:`ScaleConfig` and config/scale/*.yaml;
+    a resolved config (:func:`~efish.config.compose`) holds numbers."""
 
     hidden: int = param("${scale.hidden}", "width of every layer and of the GRU", lo=1, hi=8192)
     head_gain: float = param(0.01, "orthogonal init gain of the output heads", lo=0.0)
@@ -269,7 +270,7 @@ class TrainConfig:
 # ----------------------------------------------------------------------- assay
 @dataclass
 class AssayConfig:
-    """An evaluation assay (SPEC 11): which conditions, how many episodes, how to act."""
+    """An evaluation assay (docs/methods/assays.md): which conditions, how many episodes, how to act."""
 
     name: str = param("patchy4", "assay name, used in output paths")
     episodes: int = param(30, "episodes per condition", lo=1)
@@ -335,8 +336,10 @@ class ScaleConfig:
     train_steps: int = param(240_000, "foraging env steps per seed", lo=1)
     homing_steps: int = param(160_000, "homing env steps", lo=1)
     homing_rollout_steps: int = param(800, "steps per homing rollout", lo=1)
-    max_episodes: int = param(8, "cap on the episodes per assay condition (SPEC 11 counts at paper scale)", lo=1)
-    selection_episodes: int = param(8, "patchy4 episodes per seed for seed selection (SPEC 10)", lo=1)
+    max_episodes: int = param(8, "cap on the episodes per assay condition (the paper-scale counts of "
+                              "docs/methods/assays.md)", lo=1)
+    selection_episodes: int = param(8, "patchy4 episodes per seed for seed selection "
+                                    "(docs/methods/training.md#seed-selection)", lo=1)
     max_episode_steps: int = param(100_000, "cap on an assay episode's length (the smoke scale shortens them)", lo=1)
     top_seeds: int = param(3, "the best-ranked seeds (the selected one first): the others rerun every claim's assays "
                            "for seeds_agree, and all run the top_seed_assays (supplement)", lo=0)
@@ -357,7 +360,8 @@ class ScaleConfig:
 # -------------------------------------------------------------------- analysis
 @dataclass
 class AnalysisConfig:
-    """Parameters of the analyses of SPEC 12 (``efish analyze``); ms per step and rates in Hz follow ``env.fps``."""
+    """Parameters of the analyses (docs/methods/analyses.md, ``efish analyze``); ms per step and rates in Hz follow
+    ``env.fps``."""
 
     idi_bins: int = param(50, "IDI histogram: log-spaced bins", lo=1, hi=100_000)
     idi_lo_ms: float = param(10.0, "IDI histogram: lower edge, ms (> 0, below idi_hi_ms)", lo=0.0)
@@ -392,7 +396,7 @@ class AnalysisConfig:
     seed: int = param(0, "seed of unit subsampling, PLSC null shifts and Dunnett's p-values", lo=0)
     real_fish_idis: str = param("", "CSV or Parquet of real-fish IDIs (column idi_ms); empty: none, and the IDI "
                                 "tables say so in their reason column")
-    # claims (CLAIMS.md, ``efish claims``)
+    # claims (docs/claims/index.md, ``efish claims``)
     claims_resamples: int = param(1000, "claims: bootstrap resamples of episodes for each effect's interval", lo=1)
     claims_fit_resamples: int = param(200, "claims: bootstrap resamples of a claim that refits a model per resample "
                                       "(C4's power law; 1,000 fits take minutes at paper scale)", lo=1)

@@ -1,4 +1,5 @@
-"""Arenas and food: layouts, per-episode sampling, regrowth and drift (SPEC 6 reset, SPEC 8).
+"""Arenas and food: layouts, per-episode sampling, regrowth and drift (docs/model/environment.md#arenas-and-food;
+reset: docs/model/environment.md#step-order).
 
 Every function takes the arena config and a ``numpy.random.Generator``; none
 keeps state. Positions are in cm, angles in radians.
@@ -33,7 +34,7 @@ def sample_arena(cfg: ArenaConfig, rng: np.random.Generator) -> ArenaConfig:
 def patch_count(cfg: ArenaConfig) -> int:
     """Patches of the patchy layout: max(1, round(m * ceil(density * area))).
 
-    70 x 70: m = 1 -> 5, 0.5 -> 2, 0.25 -> 1 (SPEC 8; round half to even).
+    70 x 70: m = 1 -> 5, 0.5 -> 2, 0.25 -> 1 (docs/model/environment.md#arenas-and-food; round half to even).
     """
     base = int(np.ceil(cfg.patch_density * cfg.width_cm * cfg.height_cm))
     return max(1, int(round(cfg.food_multiplier * base)))

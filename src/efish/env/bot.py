@@ -1,4 +1,4 @@
-"""The bounded random-walk bot (SPEC 11): a cue-only conspecific that ignores every input.
+"""The bounded random-walk bot (docs/methods/assays.md#assay-bot): a cue-only conspecific that ignores every input.
 
 Each step it draws a turn U(-1, 1) and a forward drive U(0, 1) and keeps them
 with probability 1 - d / R (d: distance from the arena centre, where the patch

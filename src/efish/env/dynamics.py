@@ -1,8 +1,9 @@
-"""Numba kernels of one step of the bodies: eating, motion, bites (SPEC 5-6).
+"""Numba kernels of one step of the bodies: eating, motion, bites (docs/model/environment.md#actions-and-motion).
 
 Agents act in id order within an arena (eating and moving are sequential, as
-the SPEC's "per agent" step says); bites are resolved simultaneously after
-every agent has moved. Pure functions of arrays; (B, N) leading dimensions.
+the "per agent" step of docs/model/environment.md#step-order says); bites are
+resolved simultaneously after every agent has moved. Pure functions of arrays;
+(B, N) leading dimensions.
 """
 
 from __future__ import annotations
@@ -28,7 +29,8 @@ def body_params(env, body_radius_cm: float) -> np.ndarray:
 
 @njit(cache=True)
 def map_actions(actions, bots, muted, forced_eod, no_bite, move, turn, eod, bite, no_eating):
-    """Raw policy outputs to commands for B arenas (SPEC 5); returns False if any action is not finite.
+    """Raw policy outputs to commands for B arenas (docs/model/environment.md#actions-and-motion); returns False if any
+    action is not finite.
 
     ``actions`` float64[B, N, 4] (a_move, a_turn, eod, bite): move = sigmoid(a_move),
     turn = tanh(a_turn), eod = (eod > 0.5) unless muted, always for agents the

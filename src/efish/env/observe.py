@@ -1,4 +1,4 @@
-"""The observation vector of SPEC 4, assembled from perception and body state.
+"""The observation vector (docs/model/environment.md#observation), assembled from perception and body state.
 
 Electric perception, for A observed agents (A = env.obs_agents, 110 values for A = 4):
 Mormyromast 36 | Ampullary 24 | Knollenorgan (A-1) x 12 | size channel A-1 | tail.
@@ -26,7 +26,8 @@ def _slices(names, sizes) -> dict[str, slice]:
 
 
 def perception_width(cfg: EfishConfig) -> int:
-    """Length of the sensory block: the electric receptors (SPEC 4) or the rays of the baseline."""
+    """Length of the sensory block: the electric receptors (docs/model/environment.md#observation) or the rays of the
+    baseline."""
     se = cfg.sensors
     if se.perception == "raycast":
         return 2 * se.ray_count

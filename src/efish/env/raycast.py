@@ -1,4 +1,4 @@
-"""Ray-casting perception baseline (SPEC 11, this project's definition).
+"""Ray-casting perception baseline (docs/model/sensors.md#ray-casting, this project's definition).
 
 Rays leave the agent centre at the Mormyromast angles; each returns the
 proximity 1 - d / L of the first thing it hits within L (0 if nothing) and

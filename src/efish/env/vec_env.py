@@ -1,4 +1,4 @@
-"""``VecEnv``: B arenas stepped in one call (DESIGN "Environment API").
+"""``VecEnv``: B arenas stepped in one call (docs/architecture.md#environment-api).
 
 The engine: bodies move, eat and bite (numba kernels in :mod:`efish.env.dynamics`),
 sense (:mod:`efish.sensors.sense`) and observe (:mod:`efish.env.observe`). It
@@ -88,7 +88,7 @@ class VecEnv:
         return self._observe(self._forced_eod())
 
     def step(self, actions: np.ndarray):
-        """Advance every arena by one step (SPEC 6). See the class docstring."""
+        """Advance every arena by one step (docs/model/environment.md#step-order). See the class docstring."""
         actions = np.asarray(actions, dtype=np.float64)
         if actions.shape != (self.num_envs, self.n, 4):
             raise ValueError(f"actions must have shape ({self.num_envs}, {self.n}, 4), got {actions.shape}")
@@ -141,13 +141,14 @@ class VecEnv:
         return obs, rewards["total"], terminated, truncated, info
 
     def v_max(self) -> np.ndarray:
-        """Largest step per agent, cm (SPEC 5): speed * gain * (1 + size) / fps; 0 when frozen."""
+        """Largest step per agent, cm (docs/model/environment.md#actions-and-motion): speed * gain * (1 + size) / fps; 0
+        when frozen."""
         e = self.cfg.env
         v = e.speed_m_s * e.speed_gain * (1 + self.state.size) * 100.0 / e.fps
         return np.where(self.frozen, 0.0, v)
 
     def w_max(self) -> np.ndarray:
-        """Largest turn per agent, rad (SPEC 5); 0 when frozen."""
+        """Largest turn per agent, rad (docs/model/environment.md#actions-and-motion); 0 when frozen."""
         e = self.cfg.env
         return np.where(self.frozen, 0.0, e.turn_rad_s * e.turn_gain * (1 + self.state.size) / e.fps)
 
@@ -241,7 +242,8 @@ class VecEnv:
                         s.size, self.plan, self.cfg.env.obs_agents - 1, out)
 
     def _observe(self, eod: np.ndarray) -> np.ndarray:
-        """Observations float32[B, N, D] (SPEC 4): perception, then the tail, written into one fresh array."""
+        """Observations float32[B, N, D] (docs/model/environment.md#observation): perception, then the tail, written
+        into one fresh array."""
         e, p, s = self.cfg.env, self.perception_width, self.state
         obs = np.empty((self.num_envs, self.n, p + sum(TAIL_SIZES)), np.float32)
         self._perceive(eod, obs)

@@ -1,4 +1,4 @@
-"""Paper panels from Parquet tables (DESIGN "Figures").
+"""Paper panels from Parquet tables (docs/architecture.md#figures).
 
 One module per figure (``fig2``, ``fig3``, ``supplement``), one function per
 panel taking a dict of tables and a matplotlib Axes. :mod:`.registry` lists

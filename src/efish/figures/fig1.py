@@ -1,4 +1,5 @@
-"""Fig 1: the model: training loop and sensing schematics, food layouts, fields of EODs distorted by objects and walls, sensor layout, a scene and its EOD raster (SPEC 13).
+"""Fig 1: the model: training loop and sensing schematics, food layouts, fields of EODs distorted by objects and walls,
+sensor layout, a scene and its EOD raster (docs/methods/figures.md#panels).
 
 Field panels read the scene tables that ``efish scene`` computes with the physics (``scenes/<name>.parquet``,
 columns in :mod:`efish.rollout.scenes`); they reshape and draw, never compute a field. Also here: the
@@ -131,7 +132,7 @@ def training_loop(tables: dict[str, pd.DataFrame], ax) -> None:
 def sensing_schematic(tables: dict[str, pd.DataFrame], ax) -> None:
     """Panel B: the three senses of the focal fish (blue, emitting): its own EOD distorted by a pellet and a
     fish (Mormyromasts, active), their intrinsic fields (Ampullary organs, passive), and a conspecific's EOD
-    (Knollenorgans). Receptor counts are the config defaults (SPEC 3)."""
+    (Knollenorgans). Receptor counts are the config defaults (docs/model/sensors.md)."""
     se = SensorsConfig()
     sk.blank(ax, (-4.0, 14.0), (-6.6, 6.6))
     fy, cx, cy, px, py = 1.5, 10.5, 3.0, 4.2, 2.3  # focal height, conspecific and pellet positions
@@ -390,8 +391,9 @@ def _range_contours(ax, grid: pd.DataFrame) -> None:
 
 
 def interaction_sketch(tables: dict[str, pd.DataFrame], ax) -> None:
-    """Supplement: the pair labels of the interaction analysis (SPEC 12): i faces j when |heading - bearing
-    to j| <= facing_rad (shaded cone), faces away when >= away_rad; thresholds are the analysis defaults."""
+    """Supplement: the pair labels of the interaction analysis (docs/methods/analyses.md#analysis-interactions): i faces
+    j when |heading - bearing to j| <= facing_rad (shaded cone), faces away when >= away_rad; thresholds are
+    the analysis defaults."""
     cfg = AnalysisConfig()
     sk.blank(ax, (-3.0, 21.0), (-11.5, 5.0))
     cases = (("confronting", 0.0, np.pi), ("chasing: i chases,\nj flees", 0.0, 0.0),
@@ -414,10 +416,10 @@ def interaction_sketch(tables: dict[str, pd.DataFrame], ax) -> None:
 PANELS: list[Panel] = [
     Panel("fig1", "A", training_loop, {}, "Schematic of the training loop: vectorised arenas give every fish an "
           "observation; one shared recurrent actor acts for all; a centralised critic and the PPO update learn from "
-          "the rewards (SPEC 9). No table."),
+          "the rewards (docs/methods/training.md#mappo). No table."),
     Panel("fig1", "B", sensing_schematic, {}, "Schematic of the three senses: the focal fish's own EOD distorted "
           "by objects (Mormyromasts), intrinsic fields (Ampullary organs) and a conspecific's EOD (Knollenorgans); "
-          "receptor counts are the config defaults (SPEC 3). No table."),
+          "receptor counts are the config defaults (docs/model/sensors.md). No table."),
     Panel("fig1", "C", food_layouts, scene_input("food_layouts"), "Pellets at the start of one episode of each "
           "arena layout (training, patchy, uniform, N-patch), drawn by the environment's generators; table "
           "scenes/food_layouts.parquet (efish scene food_layouts)."),
@@ -429,8 +431,8 @@ PANELS: list[Panel] = [
           "of an arena with insulating walls: log10 |E| (V/m) and field lines; table scenes/eod_walls.parquet "
           "(efish scene eod_walls)."),
     Panel("fig1", "F", sensor_layout, scene_input("sensor_layout"), "Positions of the Mormyromasts, Ampullary "
-          "organs and Knollenorgans on the body circle (SPEC 3), drawn on offset rings to tell them apart; table "
-          "scenes/sensor_layout.parquet (efish scene sensor_layout)."),
+          "organs and Knollenorgans on the body circle (docs/model/sensors.md), drawn on offset rings to tell them "
+          "apart; table scenes/sensor_layout.parquet (efish scene sensor_layout)."),
     Panel("fig1", "G", full_scene, scene_input("full_scene"), "A scene with every element: two emitting fish "
           "(+/- poles), a silent one, pellets, walls, the summed EOD field (log10 |E|) with field lines and the focal fish's eating "
           "cone; table scenes/full_scene.parquet (efish scene full_scene)."),
@@ -443,6 +445,7 @@ PANELS: list[Panel] = [
           "Knollenorgan spike threshold) for a pellet (dashed) or a facing, emitting fish (solid); inset: the "
           "Knollenorgan range; table scenes/sensing_range.parquet (efish scene sensing_range, noise off)."),
     Panel("supp", "interaction_sketch", interaction_sketch, {}, "Schematic of the pair labels of the interaction "
-          "analysis (SPEC 12): confronting, chasing / fleeing, dispersing and unaligned, from each fish's heading "
-          "relative to the bearing of the other (facing cone pi/4, facing away 3 pi/4). No table."),
+          "analysis (docs/methods/analyses.md#analysis-interactions): confronting, chasing / fleeing, dispersing "
+          "and unaligned, from each fish's heading relative to the bearing of the other (facing cone pi/4, facing "
+          "away 3 pi/4). No table."),
 ]

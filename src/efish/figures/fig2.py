@@ -1,4 +1,5 @@
-"""Fig 2: homing towards a frozen, always-emitting target (SPEC 11, 13).
+"""Fig 2: homing towards a frozen, always-emitting target (docs/methods/assays.md#assay-homing,
+docs/methods/figures.md#panels).
 
 Agent 0 is the target, agent 1 the homer (the homing assay's layout); the
 conditions are ``electric`` (the homing policy with electric senses) and
@@ -142,8 +143,9 @@ def _analysis(table: str) -> str:
 
 PANELS = [
     Panel("fig2", "A", scene, {"steps": HOMING},
-          "Homing assay (SPEC 11): start positions of the homer (dots) and the frozen, always-emitting target "
-          "(star; the arrow is its heading, the axis of its dipole) in the electric test episodes; homing steps table."),
+          "Homing assay (docs/methods/assays.md#assay-homing): start positions of the homer (dots) and the frozen, "
+          "always-emitting target (star; the arrow is its heading, the axis of its dipole) in the electric test "
+          "episodes; homing steps table."),
     Panel("fig2", "B", trajectories, {"steps": HOMING, "perception": _analysis("perception")},
           "Homing trajectories of the homer, electric senses (solid) vs ray casting (dashed), homing assay; stars: "
           "Mann-Whitney test of tortuosity (path length / displacement) from the homing analysis's perception table."),

@@ -1,6 +1,7 @@
-"""Fig 3: signalling and foraging of the selected seed (SPEC 13), plus the supplement's IDI histogram.
+"""Fig 3: signalling and foraging of the selected seed (docs/methods/figures.md#panels), plus the supplement's IDI
+histogram.
 
-Assays (SPEC 11): the two-agent wide arena ``wide2`` for the signalling panels
+Assays (docs/methods/assays.md): the two-agent wide arena ``wide2`` for the signalling panels
 C-J, the four-agent patchy arena ``patchy4`` for the ethogram, trajectories
 and the size panels (A, B, K-P). Every panel reads analysis tables (or, for
 the trajectories, the rollout tables) and takes its tests from the analyses'
@@ -265,7 +266,8 @@ def idi_histogram_supplement(tables: dict[str, pd.DataFrame], ax) -> None:
         return
     _log_axes(ax)
     edges = tables[f"idi_{SIGNALLING}"]
-    ax.set_xlim(edges["bin_lo_ms"].min(), edges["bin_hi_ms"].max())  # the histograms' range (SPEC 12)
+    # the histograms' range (docs/methods/analyses.md#analysis-signalling)
+    ax.set_xlim(edges["bin_lo_ms"].min(), edges["bin_hi_ms"].max())
     # the range spans more decades than panel C's: labels at 1, 2, 5 x 10^k would run into each other
     from matplotlib.ticker import LogLocator
 

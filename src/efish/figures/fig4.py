@@ -1,4 +1,5 @@
-"""Fig 4: ablations of receptor classes, collective sensing gates, muting, food layouts and patch number (SPEC 13).
+"""Fig 4: ablations of receptor classes, collective sensing gates, muting, food layouts and patch number
+(docs/methods/figures.md#panels).
 
 Every panel reads the behaviour analysis's per-episode summary
 (``analysis/behaviour/<assay>/episode_summary.parquet``: food_total, theil_t,

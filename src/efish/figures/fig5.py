@@ -1,4 +1,5 @@
-"""Fig 5: the one-patch intruder assay, the bot, chasing and biting by size (SPEC 11, 13).
+"""Fig 5: the one-patch intruder assay, the bot, chasing and biting by size (docs/methods/assays.md,
+docs/methods/figures.md#panels).
 
 Who is who comes from the conditions the run recorded (``assays/<assay>/conditions.parquet``,
 read through :func:`~efish.figures.style.assay_conditions`), not from the condition names: the

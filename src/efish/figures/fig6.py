@@ -1,4 +1,5 @@
-"""Fig 6: hidden-state dynamics: dimensionality, decoding, PLSC between agents and wideband power (SPEC 13).
+"""Fig 6: hidden-state dynamics: dimensionality, decoding, PLSC between agents and wideband power
+(docs/methods/figures.md#panels).
 
 Panels read the dynamics analysis (``analysis/dynamics/<assay>/``):
 ``dimensionality`` (D_eff, PCs for the variance fraction and wideband power
@@ -128,8 +129,8 @@ def subsampling_curves(tables: Tables, ax) -> None:
 
 
 def readout_rows(decoding: pd.DataFrame) -> pd.Series:
-    """Which rows of a decoding table are readouts of the decoded vector (README, "Claims"): its ``readout`` column,
-    or, in a table written before that column existed, membership of efish.analysis.dynamics.READOUT_TARGETS."""
+    """Which rows of a decoding table are readouts of the decoded vector (docs/claims/index.md#rule-7): its ``readout``
+    column, or, in a table written before that column existed, membership of efish.analysis.dynamics.READOUT_TARGETS."""
     if "readout" in decoding.columns:
         return decoding["readout"].fillna(False).astype(bool)
     # imported here: the workflow imports every figure module to list the panels, and dynamics pulls in sklearn

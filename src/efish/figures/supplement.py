@@ -1,4 +1,5 @@
-"""Supplementary panels: training, seed selection and the top-ranked seeds (SPEC 10, 13).
+"""Supplementary panels: training, seed selection and the top-ranked seeds (docs/methods/training.md#seed-selection,
+docs/methods/figures.md#panels).
 
 Training panels read every seed's ``metrics.parquet`` (one row per PPO
 update); the selected seed is drawn in colour on top of the others in grey.
@@ -117,7 +118,8 @@ def reward_components(tables: dict[str, pd.DataFrame], ax) -> None:
 
 def seed_landscape(tables: dict[str, pd.DataFrame], ax) -> None:
     """Each seed's food per episode (x) against its median size-food slope (y), R^2 as colour; hollow markers
-    are seeds dropped for a non-positive intercept, the ring marks the selected seed (SPEC 10)."""
+    are seeds dropped for a non-positive intercept, the ring marks the selected seed
+    (docs/methods/training.md#seed-selection)."""
     import matplotlib.pyplot as plt
 
     ranking = tables["ranking"]
@@ -212,9 +214,9 @@ PANELS = [
           "Food reward and bitten penalty, mean per agent-step of each rollout, every seed, 5-point EMA "
           "(train metrics tables)."),
     Panel("supp", "seed_landscape", seed_landscape, {"ranking": layout.RANKING},
-          "Seed selection (SPEC 10): food per episode against the median size-food slope of each seed's "
-          "selection episodes, R^2 as colour; hollow markers are seeds dropped for a non-positive intercept, the "
-          "ring marks the selected seed (analysis/selection/ranking table)."),
+          "Seed selection (docs/methods/training.md#seed-selection): food per episode against the median size-food "
+          "slope of each seed's selection episodes, R^2 as colour; hollow markers are seeds dropped for a "
+          "non-positive intercept, the ring marks the selected seed (analysis/selection/ranking table)."),
     Panel("supp", "top_seeds_food", top_seeds_food, {"episodes": layout.stacked_seeds_table("patchy4")},
           "The top-ranked seeds in the patchy 4-agent assay: food per agent-episode against size with each "
           "seed's OLS line (seeds/patchy4 episodes table, stacked over the top seeds)."),

@@ -1,4 +1,4 @@
-"""Closed-form fields of point sources in SI units (SPEC 2.4), vectorised with numpy.
+"""Closed-form fields of point sources in SI units (docs/model/physics.md#field-sources), vectorised with numpy.
 
 These are the public, readable versions of the formulas; the numba kernels in
 :mod:`efish.physics.kernels` evaluate the same expressions source by source.

@@ -1,4 +1,5 @@
-"""Where the sensors sit on the body (SPEC 3): angles from the heading, radians; the conspecific slot order."""
+"""Where the sensors sit on the body (docs/model/sensors.md): angles from the heading, radians; the conspecific slot
+order."""
 
 from __future__ import annotations
 
@@ -56,7 +57,7 @@ def sensor_frame(xy: np.ndarray, heading: np.ndarray, angles: np.ndarray, radius
 def slot_agent(agent: int, slot: int) -> int:
     """The agent heard in conspecific ``slot`` of ``agent``: the other agents in id order, ``agent`` skipped.
 
-    The one definition of the slot order (SPEC 3.3) for Knollenorgans, their
+    The one definition of the slot order (docs/model/sensors.md#knollenorgans) for Knollenorgans, their
     size channels and the critic's agent-centric state.
     """
     return slot if slot < agent else slot + 1

@@ -1,13 +1,14 @@
-"""Method of images for an insulating rectangular arena [0, W] x [0, H] (SPEC 2.5).
+"""Method of images for an insulating rectangular arena [0, W] x [0, H] (docs/model/physics.md#walls-and-images).
 
 An image is indexed by how many times, and in which direction, it was mirrored
 along x (``ix``) and y (``iy``). Along one axis of length L the image of x with
 index i sits at ``i*L + x`` for even i and ``(i+1)*L - x`` for odd i (i = 1 is
 the mirror in the wall at L, i = -1 the mirror in the wall at 0, and so on).
 Order n keeps every image with |ix| + |iy| <= n: order 1 is one mirror per
-wall, the first-order method of the SPEC. Monopole images keep their sign; a
-dipole image is the mirrored vector (the component normal to each mirroring
-wall flips once per mirror). Every mirror scales the source by ``scale``.
+wall, the model's first-order method (docs/model/physics.md#walls-and-images).
+Monopole images keep their sign; a dipole image is the mirrored vector (the
+component normal to each mirroring wall flips once per mirror). Every mirror
+scales the source by ``scale``.
 """
 
 from __future__ import annotations

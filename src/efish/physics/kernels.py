@@ -76,7 +76,8 @@ def image_table(width, height, idx, weights, c):
 
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
 def induced_dipoles(axy, heading, emitting, bx, by, alpha, img, c, p_ind):
-    """p_ind[e, 0/1, body] = alpha_body * E_e(body) for every emitter e, own EOD excluded (SPEC 2.3).
+    """p_ind[e, 0/1, body] = alpha_body * E_e(body) for every emitter e, own EOD excluded
+    (docs/model/physics.md#induction).
 
     E_e is the field of e's two monopoles and all their wall images. Bodies are
     the innermost, contiguous loop so the sums vectorise; silent agents' rows are zero.

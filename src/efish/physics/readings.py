@@ -34,7 +34,7 @@ class RawReadings:
 def normalised_error_bound(raw: RawReadings, plan: EffectPlan) -> np.ndarray:
     """float64[B, N, 2]: bound of the error of every normalised Mormyromast (0) and Ampullary (1) reading.
 
-    The normalisation (SPEC 3.4) after a noise factor u is Lipschitz in the raw reading
+    The normalisation (docs/model/sensors.md#normalisation) after a noise factor u is Lipschitz in the raw reading
     with constant u / (E_min ln 10 (log10 E_max - log10 E_min)): it is flat below E_min
     and above E_max, logarithmic between. So a raw error bound times that constant, at the
     largest factor noise can draw, bounds the normalised error with or without noise.

@@ -53,7 +53,7 @@ def _reference_env(batch: SnapshotBatch, b: int, plan: EffectPlan, out: RawReadi
     bodies = np.concatenate([xy, pxy])                       # agents first, then pellets
     alpha = np.concatenate([np.full(n, plan.alpha_agent), np.full(len(pxy), plan.alpha_pellet)])
 
-    # Induced dipoles, kept per emitter: p_ind[body, emitter] (SPEC 2.3).
+    # Induced dipoles, kept per emitter: p_ind[body, emitter] (docs/model/physics.md#induction).
     p_ind = np.zeros((len(bodies), n, 2))
     if plan.on("induction"):
         for e in np.flatnonzero(emitting):
@@ -63,7 +63,7 @@ def _reference_env(batch: SnapshotBatch, b: int, plan: EffectPlan, out: RawReadi
             p_ind[:, e] = alpha[:, None] * e_at
             p_ind[e, e] = 0.0                                   # a body is not polarised by its own EOD
 
-    # Intrinsic dipoles (SPEC 2.2): agents along body +x, pellets along pellet +y.
+    # Intrinsic dipoles (docs/model/physics.md#field-sources): agents along body +x, pellets along pellet +y.
     p_int = np.concatenate([
         plan.agent_dipole * np.stack([np.cos(heading), np.sin(heading)], axis=1),
         plan.pellet_dipole * np.stack([-np.sin(phi), np.cos(phi)], axis=1)])

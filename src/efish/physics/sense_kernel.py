@@ -115,7 +115,7 @@ B_X, B_Y, B_ALPHA, B_M1X, B_M1Y, B_M2X, B_M2Y, B_T1X, B_T1Y, N_BODY = range(10)
 @njit(cache=True)
 def mormyromast_weights(a, emitting, c):
     """(w_self, w_cons): weights of the self and cons induced moments in agent ``a``'s Mormyromast moment
-    (k folded in); cons carries k_cons when ``a`` is silent or g_self = 0 (SPEC 3.1)."""
+    (k folded in); cons carries k_cons when ``a`` is silent or g_self = 0 (docs/model/sensors.md#mormyromasts)."""
     gain = c[K_CONS] if (not emitting[a] or c[G_SELF] == 0) else c[ONE]
     return c[G_SELF] * c[K], c[G_CONS] * gain * c[K]
 
@@ -125,7 +125,7 @@ def mormyromast_moments(a, emitting, p_ind, c, mx, my):
     """g_self * self + g_cons * gain * cons moment of every body for agent ``a`` (k folded in).
 
     self = p_ind[a] (zero when a is silent), cons = sum of p_ind[e] over the
-    other emitters; gain = k_cons when ``a`` is silent or g_self = 0 (SPEC 3.1).
+    other emitters; gain = k_cons when ``a`` is silent or g_self = 0 (docs/model/sensors.md#mormyromasts).
     The agent's own induced dipole is excluded (the body is the sensor).
     cons is summed directly, not formed as p_sum - p_ind[a]: near an emitting
     agent self >> cons, and the difference would lose cons to round-off (in
@@ -151,7 +151,7 @@ def mormyromast_moments(a, emitting, p_ind, c, mx, my):
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
 def own_eod_images(out, xy, heading, img, c, sx, sy, nx, ny):
     """The wall images (not the EOD itself) of an agent's own monopoles at its sensors, times g_self
-    (they are part of the self image, SPEC 3.1)."""
+    (they are part of the self image, docs/model/sensors.md#mormyromasts)."""
     ux = c[HALF_SEP] * np.cos(heading)
     uy = c[HALF_SEP] * np.sin(heading)
     for i in range(1, img.shape[0]):

@@ -1,4 +1,4 @@
-"""Generalised advantage estimation with truncation bootstrapping (SPEC 9)."""
+"""Generalised advantage estimation with truncation bootstrapping (docs/methods/training.md#mappo)."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
-"""The action distribution of one agent (SPEC 5): a diagonal 2-D Gaussian (move, turn)
-and two independent Bernoulli variables (EOD, bite) given as logits.
+"""The action distribution of one agent (docs/model/environment.md#actions-and-motion): a diagonal 2-D Gaussian (move,
+turn) and two independent Bernoulli variables (EOD, bite) given as logits.
 
 Log-probabilities are joint (sums over the four components) and computed from
 logits with softplus, so logits of +-100 saturate without NaN or infinities.

@@ -1,4 +1,4 @@
-"""One recurrent MAPPO update: the losses and the epochs over BPTT chunks (SPEC 9)."""
+"""One recurrent MAPPO update: the losses and the epochs over BPTT chunks (docs/methods/training.md#mappo)."""
 
 from __future__ import annotations
 
@@ -89,8 +89,8 @@ def ppo_update(cfg: TrainConfig, actor: Actor, critic: Critic, actor_opt: torch.
     for _ in range(cfg.epochs):
         order = torch.randperm(n_seq, generator=generator)
         for idx in order.chunk(cfg.minibatches):
-            # One optimiser step per minibatch, as in SPEC 9; the forward/backward passes run over
-            # micro-batches of sequences whose gradients add up to the minibatch's (each loss weighted by
+            # One optimiser step per minibatch, as in docs/methods/training.md#mappo; the forward/backward passes run
+            # over micro-batches of sequences whose gradients add up to the minibatch's (each loss weighted by
             # its share), because cache-sized passes run faster than one pass over the whole minibatch.
             actor_opt.zero_grad()
             critic_opt.zero_grad()

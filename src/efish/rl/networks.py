@@ -1,4 +1,5 @@
-"""Actor and critic of SPEC 9: LayerNorm(input) -> [Linear-ReLU-LayerNorm] x 2 -> GRU -> LayerNorm -> head.
+"""Actor and critic (docs/methods/training.md#mappo): LayerNorm(input) -> [Linear-ReLU-LayerNorm] x 2 -> GRU ->
+LayerNorm -> head.
 
 Both step one time step at a time (rollouts) and run whole chunks of a
 sequence (BPTT in training); masks zero the hidden state at episode starts in

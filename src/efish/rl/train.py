@@ -1,4 +1,5 @@
-"""``train(cfg, out_dir)``: recurrent MAPPO on the VecEnv, resumable (SPEC 9, DESIGN "Training").
+"""``train(cfg, out_dir)``: recurrent MAPPO on the VecEnv, resumable (docs/methods/training.md#mappo,
+docs/architecture.md#training).
 
 Readable top to bottom: collect a rollout with the current policy, compute
 advantages, run the PPO epochs, log one metrics row, checkpoint. A checkpoint

@@ -1,4 +1,4 @@
-"""Running normalisation of value targets (SPEC 9: value normalisation)."""
+"""Running normalisation of value targets (docs/methods/training.md#mappo: value normalisation)."""
 
 from __future__ import annotations
 

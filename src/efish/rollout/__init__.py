@@ -1,1 +1,1 @@
-"""Policy + env -> Parquet tables with one declared schema (DESIGN "Tables")."""
+"""Policy + env -> Parquet tables with one declared schema (docs/architecture.md#tables)."""

@@ -1,4 +1,5 @@
-"""``run_assay``: every condition of an assay config, each batched in one env, one table set (SPEC 11)."""
+"""``run_assay``: every condition of an assay config, each batched in one env, one table set
+(docs/methods/assays.md)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,5 @@
-"""What the steps table records about each agent at each step, beyond the state itself (SPEC 12, Fig 6 targets).
+"""What the steps table records about each agent at each step, beyond the state itself: the inputs of the
+analyses (docs/methods/analyses.md), Fig 6's targets among them (docs/methods/analyses.md#decoding-variables).
 
 Pure numpy on an env's state after a step (or on the observation the step
 returned): distances and bearings to the nearest bodies, the sizes of the
@@ -149,7 +150,8 @@ def angle_of(e: np.ndarray) -> np.ndarray:
 
 
 def homing_errors(env: VecEnv) -> dict[str, np.ndarray]:
-    """Heading minus the direction of the target's local field at each homer, per receptor class (SPEC 13, Fig 2C).
+    """Heading minus the direction of the target's local field at each homer, per receptor class (Fig 2C,
+    docs/methods/figures.md#panels).
 
     Knollenorgan: the target's direct EOD field; Ampullary: its intrinsic dipole's
     field; Mormyromast: the field of the dipole the homer's own EOD induces on

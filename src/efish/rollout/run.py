@@ -1,4 +1,4 @@
-"""Run a policy in the env and record the rollout tables of SPEC/DESIGN "Tables"."""
+"""Run a policy in the env and record the rollout tables (docs/architecture.md#tables)."""
 
 from __future__ import annotations
 
@@ -118,7 +118,7 @@ def hidden_table(keys: pd.DataFrame, hidden: np.ndarray) -> pd.DataFrame:
     returned (the world after step t, which the ``steps`` row t describes) and
     has produced none of row t's actions (those came from the state before).
     Merging ``hidden`` and ``steps`` on (condition, episode, t, agent) thus
-    pairs each state with the world it has observed (README, "Claims"), never with
+    pairs each state with the world it has observed (docs/claims/index.md#rule-7), never with
     the action it produced.
     """
     units = pd.DataFrame(hidden, columns=[f"h_{i}" for i in range(hidden.shape[1])])

@@ -164,7 +164,8 @@ def emitter_charges(bodies: pd.DataFrame, plan: EffectPlan, arena_m: tuple[float
 
 
 def induced_moments(bodies: pd.DataFrame, emitters: list, plan: EffectPlan, eps0: float) -> np.ndarray:
-    """Dipole (K, 2) C*m induced on every body by the EODs (with images) of every emitter but itself (SPEC 2.3)."""
+    """Dipole (K, 2) C*m induced on every body by the EODs (with images) of every emitter but itself
+    (docs/model/physics.md#induction)."""
     xy = bodies[["x_cm", "y_cm"]].to_numpy() * CM
     alpha = np.where(bodies["element"].isin(["emitter", "agent"]), plan.alpha_agent, plan.alpha_pellet)
     moments = np.zeros((len(bodies), 2))

@@ -1,4 +1,4 @@
-"""Every column of every rollout table, declared once (DESIGN "Tables").
+"""Every column of every rollout table, declared once (docs/architecture.md#tables).
 
 Columns are snake_case with units in the name where they have one. Tables are
 validated against these schemas before they are written; readers can rely on

@@ -2,7 +2,7 @@
 
 Sensor geometry (where the receptors sit) belongs to the physics
 (:mod:`efish.physics.geometry`); this layer turns raw V/m readings into the
-normalised values of SPEC 3.4.
+normalised values of docs/model/sensors.md#normalisation.
 """
 
 from .normalize import binarize, knollen_size_channel, log_normalize

@@ -1,10 +1,11 @@
-"""Raw readings to the electric part of the observation in one pass (SPEC 3.3-3.4, 4).
+"""Raw readings to the electric part of the observation in one pass (docs/model/sensors.md#normalisation).
 
 The step of the environment needs, after the physics kernel: noise, log
 normalisation, Knollenorgan binarisation, the size channel and the layout of
-SPEC 4. Done as separate numpy calls these are a dozen small passes with
-temporaries; :func:`encode_readings` does them in one numba loop that writes
-straight into the float32 observation. The unfused composition
+the observation (docs/model/environment.md#observation). Done as separate
+numpy calls these are a dozen small passes with temporaries;
+:func:`encode_readings` does them in one numba loop that writes straight into
+the float32 observation. The unfused composition
 (:func:`efish.sensors.sense.sense_batch`, i.e. ``apply_noise`` then ``normalise``)
 stays as the public ``sense`` API and is the oracle this kernel is tested
 against, bit for bit.
@@ -173,7 +174,8 @@ def log_kernel(log_mag, sgn, n_m, lin, flags, out):
 
 def encode_readings(raw: RawReadings, u: np.ndarray | None, emitting: np.ndarray, size: np.ndarray,
                     plan: EffectPlan, slots: int, out: np.ndarray) -> None:
-    """Write the electric block of SPEC 4 for every agent into ``out[..., :E]`` (float32[B, N, D]).
+    """Write the electric block of the observation (docs/model/environment.md#observation) for every agent into
+    ``out[..., :E]`` (float32[B, N, D]).
 
     ``u``: the step's noise uniforms (``noise_uniforms``), or None for no noise;
     ``emitting`` bool[B, N] (already gated by the plan); ``slots`` Knollenorgan

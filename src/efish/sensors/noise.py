@@ -1,4 +1,4 @@
-"""Seeded multiplicative sensor noise (SPEC 3.4)."""
+"""Seeded multiplicative sensor noise (docs/model/sensors.md#noise)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,5 @@
-"""From raw field readings (V/m) to observations in [-1, 1] (SPEC 3.3-3.4)."""
+"""From raw field readings (V/m) to observations in [-1, 1] (docs/model/sensors.md#normalisation,
+docs/model/sensors.md#knollenorgans)."""
 
 from __future__ import annotations
 

@@ -2,7 +2,7 @@
 
 Pipeline: effect plan -> raw fields at the sensors (fast numba path or the
 brute-force reference) -> optional seeded noise -> log normalisation and
-Knollenorgan binarisation (SPEC 3).
+Knollenorgan binarisation (docs/model/sensors.md).
 """
 
 from __future__ import annotations

@@ -1,4 +1,5 @@
-"""Foraging (SPEC 7): pellets are worth eating, approaching them is shaped, bites and collisions cost.
+"""Foraging (docs/model/environment.md#rewards): pellets are worth eating, approaching them is shaped, bites and
+collisions cost.
 
 The episode ends only at the time limit. Rewards come from one numba pass over
 the batch (:func:`foraging_kernel`), per component so that training logs each.

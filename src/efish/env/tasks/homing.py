@@ -1,4 +1,5 @@
-"""Homing (SPEC 7, 9, 11): one agent, the target, stays frozen and always emits; the others home to it.
+"""Homing (docs/methods/assays.md#assay-homing): one agent, the target, stays frozen and always emits; the others home
+to it.
 
 A step within ``homing_radius_cm`` of the target earns ``homing_reward_home``,
 approaching it is shaped by the perimeter, every step costs; an arena's
@@ -30,8 +31,8 @@ class Homing(Task):
 
     def place(self, state: EnvState, b: int, arena: ArenaConfig, rng: np.random.Generator) -> None:
         """Target and homers uniform at least ``homing_clearance_cm`` from every wall, each homer at least
-        ``homing_min_distance_cm`` from the target (SPEC 11); fixed ``env.starts`` win; with both
-        constraints 0, the base placement."""
+        ``homing_min_distance_cm`` from the target (docs/methods/assays.md#assay-homing); fixed ``env.starts`` win; with
+        both constraints 0, the base placement."""
         e = self.cfg.env
         if e.starts or not (e.homing_min_distance_cm or e.homing_clearance_cm):
             super().place(state, b, arena, rng)

@@ -1,4 +1,4 @@
-"""Starts that depend on other bodies: where each agent begins an episode, by role (SPEC 11).
+"""Starts that depend on other bodies: where each agent begins an episode, by role (docs/methods/assays.md).
 
 ``env.roles`` gives each agent a role; tasks place their agents through
 :func:`place_roles` (the homing task has its own constrained starts). Roles:

@@ -1,0 +1,189 @@
+"""MkDocs hooks of the efish site: reference pages generated from the code, and LaTeX turned into MathML.
+
+A page asks for a generated part with a marker on its own line, ``<!-- efish:config -->``,
+``<!-- efish:tables -->`` or ``<!-- efish:cli -->``; the marker is replaced when the site is built, so the
+reference can never drift from the schema, the table declarations or the argument parser.
+
+Equations are written as LaTeX (a fenced ``math`` block for display, ``$...$`` inline) and converted to
+MathML here, which browsers render natively: the built site shows equations without JavaScript or network.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import html
+import re
+from typing import Any
+
+from latex2mathml.converter import convert
+
+# --------------------------------------------------------------------- the config reference
+
+
+def _range(meta: dict) -> str:
+    """The allowed values of a field as the schema's ``param(...)`` declares them."""
+    if meta.get("choices"):
+        return " / ".join(f"`{c}`" for c in meta["choices"])
+    lo, hi = meta.get("lo"), meta.get("hi")
+    if lo is None and hi is None:
+        return ""
+    if hi is None:
+        return f"&ge; {lo:g}"
+    return f"&le; {hi:g}" if lo is None else f"[{lo:g}, {hi:g}]"
+
+
+def _cell(text: str) -> str:
+    """Plain text safe inside a Markdown table cell (no HTML, pipes or emphasis)."""
+    return html.escape(text, quote=False).replace("|", "\\|").replace("*", "\\*").replace("_", "\\_")
+
+
+def _value(value: Any) -> str:
+    text = repr(value) if isinstance(value, str) else str(value)
+    text = text if len(text) <= 40 else text[:37] + "..."
+    return f"`{text}`".replace("|", "\\|")
+
+
+def config_fields(node: Any = None, path: str = "") -> list[tuple[str, Any, dict]]:
+    """Every leaf field of the composed default config: (dotted key, default value, the ``param`` metadata)."""
+    from efish.config import compose
+
+    node = compose([]) if node is None else node
+    rows = []
+    for f in dataclasses.fields(node):
+        value, key = getattr(node, f.name), f"{path}{f.name}"
+        if dataclasses.is_dataclass(value):
+            rows += config_fields(value, f"{key}.")
+        else:
+            rows.append((key, value, dict(f.metadata)))
+    return rows
+
+
+def config_reference() -> str:
+    """Markdown: one table per config group (its keys relative to the group), every field with its default
+    (the laptop scale's), allowed range and doc."""
+    from efish.config import compose
+
+    cfg, out = compose([]), []
+    for group in dataclasses.fields(cfg):
+        node = getattr(cfg, group.name)
+        doc = " ".join((type(node).__doc__ or "").split())
+        out += [f"## `{group.name}` {{#{group.name}}}", "", doc, "",
+                "| key | default | allowed | meaning |", "|---|---|---|---|"]
+        for key, value, meta in config_fields(node):  # keys relative to the group, which heads the table
+            neutral = " *(cannot change a training result)*" if meta.get("neutral") else ""
+            text = _cell(meta.get("doc", ""))
+            out.append(f"| `{key}` | {_value(value)} | {_range(meta)} | {text}{neutral} |")
+        out.append("")
+    return "\n".join(out)
+
+
+# --------------------------------------------------------------------- the tables reference
+
+
+def tables_reference() -> str:
+    """Markdown: the columns of every rollout table (``efish schema``) and of the claims tables."""
+    from efish.analysis.claim_parts import PART_COLUMNS, ROW_COLUMNS
+    from efish.analysis.selection import RANKING_COLUMNS
+    from efish.rollout.schema import COLUMNS, HIDDEN_UNITS
+
+    out = []
+    for name, columns in COLUMNS.items():
+        out += [f"## `{name}.parquet` {{#{name}}}", "", f"`efish schema {name}` prints this list.", "",
+                "| column | type | meaning |", "|---|---|---|"]
+        out += [f"| `{col}` | `{typ}` | {_cell(doc)} |" for col, typ, doc in columns]
+        if name == "hidden":
+            out.append(f"| `h_0`, `h_1`, ... | `float` | {html.escape(HIDDEN_UNITS)} |")
+        out.append("")
+    for title, anchor, columns in (("`claims.parquet`: one row per claim", "claims", ROW_COLUMNS),
+                                   ("`claim_parts.parquet`: one row per part of a claim", "claim-parts", PART_COLUMNS),
+                                   ("`ranking.parquet`: the seed ranking", "ranking", RANKING_COLUMNS)):
+        out += [f"## {title} {{#{anchor}}}", "", ", ".join(f"`{c}`" for c in columns), ""]
+    return "\n".join(out)
+
+
+# --------------------------------------------------------------------- the command-line reference
+
+
+def cli_reference() -> str:
+    """Markdown: ``efish --help`` and every subcommand's help, as argparse prints them."""
+    from efish.cli import _parser
+
+    parser = _parser()
+    out = ["## `efish` {#efish}", "", "```text", parser.format_help().rstrip(), "```", ""]
+    subparsers = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    for name, sub in subparsers.choices.items():
+        out += [f"## `efish {name}` {{#{name}}}", "", "```text", sub.format_help().rstrip(), "```", ""]
+    return "\n".join(out)
+
+
+GENERATED = {"config": config_reference, "tables": tables_reference, "cli": cli_reference}
+
+# --------------------------------------------------------------------- LaTeX to MathML
+
+FENCE = re.compile(r"^(?P<indent> *)(?P<fence>```+|~~~+)(?P<info>[^\n]*)\n(?P<body>.*?)^(?P=indent)(?P=fence)[ \t]*$",
+                   re.M | re.S)
+INLINE_CODE = re.compile(r"(`+)(?:.+?)\1", re.S)
+INLINE_MATH = re.compile(r"(?<![\\$\w])\$(?=\S)(?P<tex>[^$\n]+?)(?<=\S)\$(?![\w$])")
+
+
+def mathml(tex: str, display: bool) -> str:
+    """The LaTeX ``tex`` as one line of MathML (block or inline)."""
+    markup = convert(tex.strip(), display="block" if display else "inline")
+    return markup.replace("\n", "")
+
+
+def _inline_math(text: str) -> str:
+    """``$...$`` outside inline code spans to MathML."""
+    parts, last = [], 0
+    for code in INLINE_CODE.finditer(text):
+        parts += [INLINE_MATH.sub(lambda m: mathml(m["tex"], False), text[last:code.start()]), code.group(0)]
+        last = code.end()
+    parts.append(INLINE_MATH.sub(lambda m: mathml(m["tex"], False), text[last:]))
+    return "".join(parts)
+
+
+def render_math(markdown: str) -> str:
+    """Fenced ``math`` blocks and inline ``$...$`` to MathML; other code blocks are left as they are."""
+    out, last = [], 0
+    for block in FENCE.finditer(markdown):
+        out.append(_inline_math(markdown[last:block.start()]))
+        if block["info"].strip() == "math":
+            out.append(f'{block["indent"]}<div class="math">{mathml(block["body"], True)}</div>\n')
+        else:
+            out.append(block.group(0))
+        last = block.end()
+    out.append(_inline_math(markdown[last:]))
+    return "".join(out)
+
+
+# --------------------------------------------------------------------- the hook MkDocs calls
+
+MARKER = re.compile(r"^<!-- efish:(\w+) -->$", re.M)
+DOC_REFERENCE = re.compile(r"\bdocs/(?P<page>[\w/-]+\.md)(?P<anchor>#[\w-]+)?")
+
+
+def link_docs(markdown: str, page_path: str) -> str:
+    """The code's ``docs/<page>.md#anchor`` references, outside code blocks, as links relative to ``page_path``."""
+    depth = page_path.count("/")
+
+    def link(m: re.Match) -> str:
+        target = "../" * depth + m["page"] + (m["anchor"] or "")
+        return f"[{m['page'].removesuffix('.md')}]({target})"
+
+    out, last = [], 0
+    for block in FENCE.finditer(markdown):
+        out += [DOC_REFERENCE.sub(link, markdown[last:block.start()]), block.group(0)]
+        last = block.end()
+    out.append(DOC_REFERENCE.sub(link, markdown[last:]))
+    return "".join(out)
+
+
+def on_page_markdown(markdown: str, page: Any, config: Any, files: Any) -> str:
+    """Fill the generated parts a page asks for, then render its math."""
+    def generated(match: re.Match) -> str:
+        if match[1] not in GENERATED:
+            raise ValueError(f"{page.file.src_path}: unknown generated part {match[1]!r} "
+                             f"(known: {', '.join(GENERATED)})")
+        return link_docs(GENERATED[match[1]](), page.file.src_path)
+    return render_math(MARKER.sub(generated, markdown))
