@@ -28,14 +28,16 @@ SOURCES = ("src", "tests", "workflow", "config", "docs", "Snakefile", "README.md
 TEXT_SUFFIXES = {".py", ".md", ".smk", ".yaml", ".yml", ".rst", ".toml", ".sh", ".txt", ""}
 
 
-def _hooks():
-    spec = importlib.util.spec_from_file_location("efish_docs_hooks", DOCS / "hooks.py")
+def _load(name: str):
+    """A Python file of docs/ (the site's build code), loaded as a module."""
+    spec = importlib.util.spec_from_file_location(f"efish_docs_{name}", DOCS / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
 
 
-HOOKS = _hooks()
+HOOKS = _load("hooks")
+DOCSTRINGS = _load("griffe_docstrings")
 
 
 def project_files():
@@ -100,6 +102,16 @@ def test_the_codes_docs_references_become_links_in_generated_pages_outside_code(
     out = HOOKS.link_docs(text, "reference/config.md")
     assert out.startswith("Sources ([model/physics](../model/physics.md#field-sources)).")
     assert "see docs/model/physics.md" in out
+
+
+def test_docstrings_become_markdown_with_fenced_doctests_roles_as_code_and_field_lines_kept():
+    text = ("Rank seeds with :func:`~efish.analysis.selection.rank_seeds`.\n\nagent_xy: float64[N, 2]  # cm\n"
+            "agent_size: float64[N]  # in [0, 1]\n\nFor example:\n>>> 1 + 1\n2\n\nA prose line: with a colon.")
+    out = DOCSTRINGS.markdown_docstring(text).split("\n")
+    assert out[0] == "Rank seeds with `rank_seeds`."
+    assert out[2:6] == ["```text", "agent_xy: float64[N, 2]  # cm", "agent_size: float64[N]  # in [0, 1]", "```"]
+    assert out[7:12] == ["For example:", "", "```pycon", ">>> 1 + 1", "2"] and out[12] == "```"
+    assert out[-1] == "A prose line: with a colon."
 
 
 def test_an_unknown_generated_part_stops_the_build_naming_it():
