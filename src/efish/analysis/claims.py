@@ -249,7 +249,10 @@ def c6(ctx: Context) -> list[Part]:
         near = curves[(lag >= e0) & (lag <= e1)].groupby("condition")["mean_hz"].mean()
         base = curves[(lag >= b0) & (lag <= b1)].groupby("condition")["mean_hz"].mean()
         diff = (near - base).dropna().rename("diff").reset_index()
-        diff["episode"] = diff["condition"].str.rsplit("|", n=2).str[1]
+        # back to the real condition and episode, so the interval resamples episodes within each condition
+        # (with the agent-episode as its own stratum, every resample would be the data itself: a zero-width CI)
+        parts = diff["condition"].str.rsplit("|", n=2)
+        diff["condition"], diff["episode"] = parts.str[0], parts.str[1]
         return one_sample_part(ctx, diff, "diff", 0.0, +1)
     stat = (f"median over agent-episodes of the mean EOD rate at lags [{e0}, {e1}] minus [{b0}, {b1}] steps of "
             "the event (wide2); Wilcoxon vs 0")
