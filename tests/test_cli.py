@@ -10,7 +10,7 @@ import pandas as pd
 import pytest
 
 from efish.analysis.claim_parts import PART_COLUMNS, ROW_COLUMNS
-from efish.cli import ReturnLog, main
+from efish.cli import ReturnLog, _parser, _recipe_override, main
 
 from .analysis.test_claims_stages import STEPS, stage_parts
 
@@ -259,6 +259,21 @@ def test_config_lists_the_bench_sizes(capsys):
     out = capsys.readouterr().out
     for key in ("env_envs: 16", "train_skip_below: 0.5", "budget_minutes:", "multipole_width_cm: 560.0"):
         assert key in out
+
+
+@pytest.mark.parametrize("argv, layout", [
+    (["train"], "training"), (["bench", "train"], "training"), (["bench", "budget"], "training"),
+    (["train", "policy=homing"], "training"), (["train", "arena=patchy70"], "patchy"),
+    (["bench", "physics"], "patchy"), (["assay"], "patchy")])
+def test_training_commands_sample_the_papers_arenas(argv, layout):
+    """efish train and the benches that time it compose policy=foraging before the user's overrides, so they
+    train on sampled arenas unless told otherwise; the other commands keep the default assay's arena."""
+    from efish.config import compose
+
+    args = _parser().parse_args([*argv, *(["--policy", "p"] if argv == ["assay"] else [])])
+    cfg = compose([*_recipe_override(args), *args.overrides])
+    assert cfg.arena.layout == layout
+    assert (cfg.env.task == "homing") == ("policy=homing" in argv)
 
 
 def test_default_folders_are_the_runs(tmp_path, monkeypatch, capsys):

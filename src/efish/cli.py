@@ -42,7 +42,8 @@
                                               slurm profile (from the laptop run's benchmark files)
 
 Overrides are Hydra's ``key=value`` (``physics.image_order=2``) or group
-choices (``arena=patchy70``). The benchmarks' sizes are ``bench.*`` fields
+choices (``arena=patchy70``). ``efish train`` composes ``policy=foraging`` first: the paper's
+training arenas, sampled per episode (config/policy/). The benchmarks' sizes are ``bench.*`` fields
 (``efish config`` lists them); a bench command's flags override them for one
 run. Every error is one line on stderr, exit code 2, and nothing is written.
 """
@@ -91,7 +92,7 @@ def _parser() -> argparse.ArgumentParser:
     tr.add_argument("overrides", nargs="*")
     tr.add_argument("--out", type=Path, help="output folder (default results/{run}/train/seed_{seed})")
     tr.add_argument("--restart", action="store_true", help="discard a checkpoint in --out and start afresh")
-    tr.set_defaults(handler=_train)
+    tr.set_defaults(handler=_train, recipe=TRAINING_RECIPE)
     asy = sub.add_parser("assay", help="run an assay with a trained policy into Parquet tables")
     asy.add_argument("overrides", nargs="*")
     asy.add_argument("--policy", nargs="+", required=True, metavar="[NAME=]PATH",
@@ -223,7 +224,7 @@ def _bench_parsers(b: argparse.ArgumentParser) -> None:
     bt.add_argument("overrides", nargs="*")
     bt.add_argument("--json", action="store_true", help="print JSON instead of a table")
     bt.add_argument("--hidden", type=int, nargs="+", help="widths to time (default bench.train_hidden)")
-    bt.set_defaults(handler=_bench_train)
+    bt.set_defaults(handler=_bench_train, recipe=TRAINING_RECIPE)
     bb = bsub.add_parser("budget", help="at fixed training time: a wider network, more env steps or more seeds")
     bb.add_argument("overrides", nargs="*")
     bb.add_argument("--minutes", type=float, help="wall time of each run (default bench.budget_minutes)")
@@ -231,7 +232,7 @@ def _bench_parsers(b: argparse.ArgumentParser) -> None:
     bb.add_argument("--seeds", type=int, help="seeds per width (default bench.budget_seeds)")
     bb.add_argument("--jobs", type=int, help="runs at a time, one thread each (default bench.budget_jobs)")
     bb.add_argument("--out", type=Path, help="also write bench_budget.parquet (+ config, provenance) here")
-    bb.set_defaults(handler=_bench_budget)
+    bb.set_defaults(handler=_bench_budget, recipe=TRAINING_RECIPE)
     bpl = bsub.add_parser("pipeline", help="time per rule family of a finished pipeline run")
     bpl.add_argument("overrides", nargs="*")
     bpl.add_argument("--results", type=Path, help="results folder of the run (default results/{run})")
@@ -584,6 +585,16 @@ def _bench_scaling(args, cfg, started) -> None:
         print(f"wrote {table} and {', '.join(map(str, figures))}")
 
 
+# The recipe (config/policy/) that ``efish train`` and the benches timing training compose before the user's
+# overrides: the paper's sampled training arenas, which the default assay's fixed arena would otherwise replace.
+TRAINING_RECIPE = "foraging"
+
+
+def _recipe_override(args: argparse.Namespace) -> list[str]:
+    """``policy=<recipe>`` for the commands that train (a ``policy=`` or ``arena=`` of the user's still wins)."""
+    return [f"policy={args.recipe}"] if getattr(args, "recipe", None) else []
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``efish`` console script: parse, compose the overrides (commands that take them), call the
     command's handler; an error is one line on stderr and exit code 2."""
@@ -591,7 +602,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     logging.basicConfig(level=logging.INFO, format="efish: %(message)s", stream=sys.stderr)
     started = datetime.now(timezone.utc)
     try:
-        cfg = compose(args.overrides) if "overrides" in args else None
+        cfg = compose([*_recipe_override(args), *args.overrides]) if "overrides" in args else None
         args.handler(args, cfg, started)
     except (ConfigError, ValueError, OSError) as exc:
         print(f"efish: error: {exc}", file=sys.stderr)

@@ -37,6 +37,18 @@ def test_default_config_matches_the_spec(default_cfg):
     assert (se.noise.low, se.noise.high, se.noise.interference_low, se.noise.interference_high) == (0.95, 1.05, 0.0, 2.0)
 
 
+def test_the_foraging_recipe_trains_in_the_papers_sampled_arenas(default_cfg):
+    """policy=foraging (what efish train composes first) replaces the default assay's 70 x 70 patchy arena by the
+    paper's training distribution (docs/model/environment.md#arenas-and-food): sides 40 + 260 u^3 cm,
+    patchy : uniform 5 : 1, food multiplier log-uniform in 0.5-2."""
+    assert default_cfg.arena.layout == "patchy"
+    a = compose(["policy=foraging"]).arena
+    assert a.layout == "training"
+    assert (a.train_size_min_cm, a.train_size_span_cm, a.train_size_exponent) == (40.0, 260.0, 3.0)
+    assert (a.train_patchy_weight, a.train_uniform_weight, a.train_none_weight) == (5.0, 1.0, 0.0)
+    assert (a.train_multiplier_min, a.train_multiplier_max) == (0.5, 2.0)
+
+
 def test_overrides_are_applied():
     cfg = cfg_with("physics.image_order=2", "sensors.knollenorgan.enabled=false", "physics.dtype=float32")
     assert cfg.physics.image_order == 2 and not cfg.sensors.knollenorgan.enabled

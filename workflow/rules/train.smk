@@ -1,4 +1,5 @@
-# Training: every foraging seed of the scale, and every policy recipe an assay asks for
+# Training: every foraging seed of the scale (recipe config/policy/foraging.yaml: the paper's arenas, sampled per
+# episode), and every policy recipe an assay asks for
 # (config/policy/<name>.yaml composes its task, arenas and training: homing, homing_raycast). efish train
 # checkpoints beside the declared output and writes final.pt atomically at the
 # end, so a killed job is rerun and resumes from its last checkpoint. A seed also keeps its policy at the
@@ -20,7 +21,7 @@ rule train:
     conda:
         "../envs/efish.yaml"
     shell:
-        efish("train", "train.seed={wildcards.seed} train.threads={threads} --out {params.out}")
+        efish("train", "policy=foraging train.seed={wildcards.seed} train.threads={threads} --out {params.out}")
 
 
 rule train_policy:
