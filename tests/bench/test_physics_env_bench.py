@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from efish.bench.env import bench_env, format_env
+from efish.bench.env import bench_env, format_env, scene_config
 from efish.bench.physics import bench_physics, format_physics
 
 from ..helpers import cfg_with
@@ -29,3 +29,12 @@ def test_env_bench_sizes_are_config_fields():
     rows = bench_env(cfg_with("bench.reference_rounds=1", "bench.env_envs=1", "bench.env_steps=2"),
                      reference_steps=1)
     assert [r["num_envs"] for r in rows] == [1, 1]
+
+
+def test_env_bench_scenes_keep_the_users_overrides():
+    """Each scene sets its arena and agent count; a physics or sensor override of the command still applies."""
+    cfg = cfg_with("physics.image_order=2", "sensors.knollenorgan.enabled=false")
+    for arena, (layout, agents) in {"patchy70": ("patchy", 4), "onepatch": ("onepatch", 2)}.items():
+        scene = scene_config(cfg, arena)
+        assert (scene.arena.layout, scene.env.n_agents) == (layout, agents)
+        assert scene.physics.image_order == 2 and not scene.sensors.knollenorgan.enabled

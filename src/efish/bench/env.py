@@ -11,6 +11,16 @@ from ..env.vec_env import VecEnv
 from .timing import best_times_interleaved, machine, machine_line
 
 SCENES = {"patchy70": "4-agent patchy 70x70", "onepatch": "2-agent one-patch 150x150"}
+SCENE_AGENTS = {"patchy70": 4, "onepatch": 2}
+
+
+def scene_config(cfg: EfishConfig, arena: str) -> EfishConfig:
+    """``cfg`` with one benchmark scene's arena and agent count, and episodes that never end: the user's physics,
+    sensor and env overrides still apply, so ``efish bench env physics.image_order=2`` times what it says."""
+    from ..config import compose
+
+    env = dataclasses.replace(cfg.env, n_agents=SCENE_AGENTS[arena], episode_steps=10**9)
+    return dataclasses.replace(cfg, arena=compose([f"arena={arena}"]).arena, env=env)
 
 
 def _random_actions(rng: np.random.Generator, b: int, n: int) -> np.ndarray:
@@ -45,10 +55,7 @@ def bench_env(cfg: EfishConfig, num_envs: int | None = None, steps: int | None =
     info = machine()
     rows = []
     for arena, label in SCENES.items():
-        from ..config import compose
-
-        scene = compose([f"arena={arena}", f"env.n_agents={4 if arena == 'patchy70' else 2}"])
-        scene = dataclasses.replace(scene, env=dataclasses.replace(scene.env, episode_steps=10**9))
+        scene = scene_config(cfg, arena)
         fast, fast_n = env_runner(scene, num_envs, steps, cfg.bench.seed)
         ref, ref_n = env_runner(scene, num_envs, reference_steps, cfg.bench.seed, reference=True)
         fast()  # compiles
