@@ -10,8 +10,8 @@ from ..config.schema import EfishConfig
 from ..env.vec_env import VecEnv
 from .timing import best_times_interleaved, machine, machine_line
 
-SCENES = {"patchy70": "4-agent patchy 70x70", "onepatch": "2-agent one-patch 150x150"}
-SCENE_AGENTS = {"patchy70": 4, "onepatch": 2}
+# arena option -> (row label, agents)
+SCENES = {"patchy70": ("4-agent patchy 70x70", 4), "onepatch": ("2-agent one-patch 150x150", 2)}
 
 
 def scene_config(cfg: EfishConfig, arena: str) -> EfishConfig:
@@ -19,7 +19,7 @@ def scene_config(cfg: EfishConfig, arena: str) -> EfishConfig:
     sensor and env overrides still apply, so ``efish bench env physics.image_order=2`` times what it says."""
     from ..config import compose
 
-    env = dataclasses.replace(cfg.env, n_agents=SCENE_AGENTS[arena], episode_steps=10**9)
+    env = dataclasses.replace(cfg.env, n_agents=SCENES[arena][1], episode_steps=10**9)
     return dataclasses.replace(cfg, arena=compose([f"arena={arena}"]).arena, env=env)
 
 
@@ -54,7 +54,7 @@ def bench_env(cfg: EfishConfig, num_envs: int | None = None, steps: int | None =
         raise ValueError(f"bench env needs at least one arena and one step; got {num_envs} arenas, {steps} steps")
     info = machine()
     rows = []
-    for arena, label in SCENES.items():
+    for arena, (label, _) in SCENES.items():
         scene = scene_config(cfg, arena)
         fast, fast_n = env_runner(scene, num_envs, steps, cfg.bench.seed)
         ref, ref_n = env_runner(scene, num_envs, reference_steps, cfg.bench.seed, reference=True)
