@@ -113,9 +113,9 @@ def c4(flip):
     return {A("signalling", "wide2", "power_law"): fit, A("signalling", "wide2", "idis"): ids}
 
 
-def wide_steps(flip: bool, episodes: int = 8, steps: int = 600) -> pd.DataFrame:
+def wide_steps(flip: bool, episodes: int = 8, steps: int = 600, null: bool = False) -> pd.DataFrame:
     """Two agents whose EOD rate depends on distance to agent, food and wall (``flip``: does not) and rises around
-    eating, biting and being bitten (``flip``: falls)."""
+    eating, biting and being bitten (``flip``: falls; ``null``: the same EOD probability, 0.3, at every step)."""
     rng = np.random.default_rng(5)
     rows = []
     events = np.zeros(steps, bool)
@@ -129,6 +129,7 @@ def wide_steps(flip: bool, episodes: int = 8, steps: int = 600) -> pd.DataFrame:
                  for k, period in (("agent", 240), ("food", 170), ("wall", 130))}
             by_distance = 0.3 if flip else 0.05 + 0.3 * (d["agent"] < 50) + 0.2 * (d["food"] < 3) + 0.2 * (d["wall"] < 3)
             p = np.where(near, 0.02 if flip else 0.95, by_distance)
+            p = np.full(steps, 0.3) if null else p
             rows.append(pd.DataFrame({"condition": "control", "episode": e, "agent": a, "t": np.arange(steps),
                                       "eod": rng.random(steps) < p, "ate": events, "bit": events,
                                       "was_bitten": events, **{f"dist_{k}_cm": v for k, v in d.items()}}))
@@ -515,6 +516,14 @@ def test_the_authors_self_only_mode_is_reported_beside_and_does_not_decide():
     row = cl.CLAIMS["C11"].run(tables, CFG)
     assert "food, self-only (authors' mode) (beside, not deciding): fails" in row["reason"]
     assert row["verdict"] == "holds"
+
+
+def test_c6_without_a_planted_event_effect_is_weaker_with_a_proper_interval():
+    """EOD probability unrelated to the events: no part holds or fails, and each interval spans 0 with a width."""
+    _, assessed = cl.CLAIMS["C6"].assess({R("wide2", "steps"): wide_steps(False, null=True)}, CFG)
+    parts = pd.DataFrame(part_rows("C6", assessed), columns=PART_COLUMNS)
+    assert (parts["verdict"] == "weaker").all(), parts[["part", "verdict", "reason"]]
+    assert ((parts["ci_low"] < 0) & (parts["ci_high"] > 0)).all(), parts[["part", "ci_low", "ci_high"]]
 
 
 def test_no_planted_effect_at_large_n_is_weaker_not_holds_nor_fails():
