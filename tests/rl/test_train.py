@@ -8,7 +8,7 @@ import pytest
 import torch
 
 from efish.config import compose
-from efish.rl.train import CHECKPOINT, FINAL, METRICS, train
+from efish.rl.train import CHECKPOINT, FINAL, METRICS, STAGE_COPIES, train
 
 TINY = ["env=homing", "arena=uniform70", "arena.width_cm=30", "arena.height_cm=30", "arena.layout=none",
         "env.episode_steps=20", "train.hidden=16", "train.num_envs=2", "train.rollout_steps=20", "train.chunk=5",
@@ -26,7 +26,9 @@ def weights(path):
 def test_training_writes_metrics_and_checkpoint(tmp_path):
     df = train(tiny(2), tmp_path)
     assert list(df["update"]) == [1, 2] and (tmp_path / CHECKPOINT).exists()
-    assert (tmp_path / FINAL).read_bytes() == (tmp_path / CHECKPOINT).read_bytes()
+    final, checkpoint = (torch.load(tmp_path / name, weights_only=False) for name in (FINAL, CHECKPOINT))
+    assert set(checkpoint) - set(final) == {STAGE_COPIES} and final["update"] == checkpoint["update"] == 2
+    assert_same(final["actor"], checkpoint["actor"])  # the checkpoint's policy, without its stage copies
     stored = pd.read_parquet(tmp_path / METRICS)
     for col in ("env_steps", "wall_s", "episode_return", "reward_home", "policy_loss", "value_loss", "entropy",
                 "approx_kl", "clip_fraction", "explained_variance", "env_steps_per_s"):
@@ -230,11 +232,32 @@ def test_a_missing_stage_is_written_from_the_checkpoint_of_its_update_or_is_one_
     (tmp_path / FINAL).unlink()
     train(cfg, tmp_path)                 # a finished run rerun: no update, the stage from the checkpoint
     assert_same(stage_weights(tmp_path, 2), before)
+    state = torch.load(tmp_path / CHECKPOINT, weights_only=False)
+    del state[STAGE_COPIES]                    # a checkpoint without its stage copies (as written before they existed)
+    torch.save(state, tmp_path / CHECKPOINT)
     (tmp_path / "stage_1.pt").unlink()   # its update is behind the checkpoint: it cannot be recreated
     with pytest.raises(ValueError, match=r"stage_1\.pt \(train\.keep_stages fraction 0\.5, update 1\).*--restart"):
         train(cfg, tmp_path)
     train(tiny(2), tmp_path, restart=True)  # --restart discards the stages too
     assert not list(tmp_path.glob("stage_*.pt"))
+
+
+def test_a_rerun_after_the_workflow_removed_its_outputs_writes_the_passed_stages_again(tmp_path):
+    """Snakemake removes an interrupted job's outputs (final.pt, metrics.parquet and every stage) before it
+    reruns it: the checkpoint's copies bring back the stages it has passed, equal to an uninterrupted run's."""
+    straight, killed = tmp_path / "straight", tmp_path / "killed"
+    cfg = tiny(4, "train.checkpoint_every=1", "train.keep_stages=[0.25,0.5,1.0]")  # stages at updates 1, 2, 4
+    train(cfg, straight)
+    with pytest.raises(Killed):
+        train(cfg, killed, progress=kill_after(3))  # checkpoint of update 3, past stages 1 and 2
+    for name in ("stage_1.pt", "stage_2.pt", METRICS):
+        (killed / name).unlink()
+    df = train(cfg, killed)
+    assert list(df["update"]) == [1, 2, 3, 4]
+    for k in (1, 2, 3):
+        assert_same(stage_weights(straight, k), stage_weights(killed, k))
+    assert STAGE_COPIES not in torch.load(killed / FINAL, weights_only=False)  # the final policy alone
+    assert sorted(torch.load(killed / CHECKPOINT, weights_only=False)[STAGE_COPIES]) == [1, 2, 3]
 
 
 def test_a_checkpoint_without_stages_resumes_with_them(tmp_path):

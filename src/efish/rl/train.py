@@ -9,13 +9,16 @@ with the same weights as an uninterrupted one. The networks and the update run
 on ``train.device``; the environment and every random draw stay on the CPU.
 ``train.keep_stages`` keeps the policy at fractions of the run as ``stage_<k>.pt``
 (:func:`stage_updates` says where), a checkpoint each: training is unchanged.
+The checkpoint carries a copy of each stage it has passed, because a workflow
+removes the outputs of an interrupted job before it reruns it: the rerun writes
+those stages again from the copy instead of failing.
 """
 
 from __future__ import annotations
 
+import copy
 import logging
 import math
-import shutil
 import time
 from pathlib import Path
 
@@ -38,6 +41,7 @@ CHECKPOINT = "checkpoint.pt"
 LOG = logging.getLogger(__name__)
 FINAL = "final.pt"  # the finished run: what the pipeline declares as the training output
 METRICS = "metrics.parquet"
+STAGE_COPIES = "stage_copies"  # checkpoint key: {k: stage file contents} of the stages the run has passed
 CPU = torch.device("cpu")
 
 
@@ -187,6 +191,7 @@ def train(cfg: EfishConfig, out_dir: str | Path, progress=None, restart: bool = 
         LOG.info("resumed from %s at update %d (%d env steps)", out / CHECKPOINT, update, update * steps_per_update)
     out.mkdir(parents=True, exist_ok=True)
     todo = stages_to_write(out, plan, state, cfg, compute)  # before training: ``state`` still holds its update
+    passed = stages_passed(out, plan, state)
     stage_at = {stage["update"] for stage in plan}
     start = time.perf_counter()
     while update < total_updates:
@@ -202,16 +207,21 @@ def train(cfg: EfishConfig, out_dir: str | Path, progress=None, restart: bool = 
             progress(rows[-1], total_updates)
         # a stage's update is always checkpointed, so a killed run resumes at or before it and never skips it
         if update % t_cfg.checkpoint_every == 0 or update == total_updates or update in stage_at:
-            saved = save_checkpoint(out / CHECKPOINT, cfg, compute, learner, env, carry, generator, update, rows)
+            saved = checkpoint_state(cfg, compute, learner, env, carry, generator, update, rows)
+            due = [stage for stage in todo if stage["update"] == update]
+            # a copy: ``saved`` shares memory with the live networks, and ``passed`` outlives this update
+            passed.update({stage["k"]: stage_contents(copy.deepcopy(saved), stage) for stage in due})
+            write_checkpoint(out / CHECKPOINT, {**saved, STAGE_COPIES: passed})
             write_metrics(out / METRICS, rows)
-            for stage in todo:
-                if stage["update"] == update:
-                    write_stage(out / stage_file(stage["k"]), saved, stage)
+            for stage in due:
+                write_stage(out / stage_file(stage["k"]), passed[stage["k"]])
     # Written at the end, atomically: a killed job never leaves a final.pt, so the workflow reruns it and the
     # rerun resumes from checkpoint.pt; a finished run rerun with its config writes both outputs again.
     write_metrics(out / METRICS, rows)
+    final = read_checkpoint(out / CHECKPOINT)
+    final.pop(STAGE_COPIES, None)  # the final policy alone; its stage copies stay in the checkpoint
     with atomic_path(out / FINAL) as tmp:
-        shutil.copyfile(out / CHECKPOINT, tmp)
+        torch.save(final, tmp)
     df = pd.DataFrame(rows)
     df.attrs["compute"] = compute.record()
     return df
@@ -245,29 +255,49 @@ def stages_to_write(out: Path, plan: list[dict], state: dict | None, cfg: EfishC
     """The stages this run still has to write when it reaches their updates.
 
     A fresh run writes every stage (over any file left in the folder). A resumed run keeps, and never rewrites,
-    each stage file it finds written at the same fraction and update under its config; one due at the
-    checkpoint's update (a run killed between its checkpoint and its stage, or a finished run rerun) is written
-    now from the checkpoint, which holds that very state; one due before the checkpoint's update that is missing
-    or from another plan (the checkpoint was written without these stages, or a longer ``total_steps`` moved the
-    stage behind it) cannot be recreated: one clear error, before any training.
+    each stage file it finds written at the same fraction and update under its config. One that is missing or
+    from another plan is written again now when the checkpoint can recreate it: from the copy the checkpoint
+    carries of each stage it passed (a workflow removes an interrupted job's outputs before it reruns it), or
+    from the checkpoint itself when the stage is due at its update (a run killed between its checkpoint and its
+    stage, or a finished run rerun). One due before the checkpoint's update that it holds no copy of (the
+    checkpoint was written without these stages, or a longer ``total_steps`` moved the stage behind it) is one
+    clear error, before any training.
     """
     if state is None:
         return list(plan)
     todo = []
+    passed = state.get(STAGE_COPIES, {})
     for stage in plan:
         path = out / stage_file(stage["k"])
+        copy = passed.get(stage["k"], {}).get("stage", {})
         if _stage_is_kept(path, stage, cfg, compute):
             continue
         if stage["update"] > state["update"]:
             todo.append(stage)
+        elif _same_stage(copy, stage):
+            write_stage(path, passed[stage["k"]])
         elif stage["update"] == state["update"]:
-            write_stage(path, state, stage)
+            write_stage(path, stage_contents(state, stage))
         else:
             raise ValueError(f"{path} (train.keep_stages fraction {stage['fraction']:g}, update {stage['update']}) "
                              f"is missing or from another plan, and the checkpoint is past it at update "
                              f"{state['update']}, so it cannot be recreated: run again with --restart to start "
                              "afresh, or with other train.keep_stages")
     return todo
+
+
+def stages_passed(out: Path, plan: list[dict], state: dict | None) -> dict[int, dict]:
+    """The contents of the plan's stages at or before the checkpoint's update, read from their files (which
+    :func:`stages_to_write` has made sure of): what the checkpoint carries on, keyed by ``k``."""
+    if state is None:
+        return {}
+    return {stage["k"]: torch.load(out / stage_file(stage["k"]), weights_only=False, map_location="cpu")
+            for stage in plan if stage["update"] <= state["update"]}
+
+
+def _same_stage(record: dict, stage: dict) -> bool:
+    """Whether a stored stage record is this stage of the plan (the same fraction kept at the same update)."""
+    return (record.get("fraction"), record.get("update")) == (stage["fraction"], stage["update"])
 
 
 def _stage_is_kept(path: Path, stage: dict, cfg: EfishConfig, compute: Compute) -> bool:
@@ -280,14 +310,20 @@ def _stage_is_kept(path: Path, stage: dict, cfg: EfishConfig, compute: Compute) 
         differ = _config_differences(saved, cfg, compute)
     except Exception:  # truncated or foreign: written again when due, or one clear error when passed
         return False
-    return (record.get("fraction"), record.get("update")) == (stage["fraction"], stage["update"]) and not differ
+    return _same_stage(record, stage) and not differ
 
 
-def write_stage(path: Path, state: dict, stage: dict) -> None:
-    """A stage file, atomically: the checkpoint ``state`` of the stage's update (so :func:`~efish.rl.policy.
-    load_policy` reads it) with the stage's record under ``stage``."""
+def stage_contents(state: dict, stage: dict) -> dict:
+    """What a stage file holds: the checkpoint ``state`` of the stage's update (so :func:`~efish.rl.policy.
+    load_policy` reads it), without the stage copies it carries, and the stage's record under ``stage``."""
+    return {**{k: v for k, v in state.items() if k != STAGE_COPIES}, "stage": dict(stage)}
+
+
+def write_stage(path: Path, contents: dict) -> None:
+    """A stage file (:func:`stage_contents`), atomically."""
+    stage = contents["stage"]
     with atomic_path(path) as tmp:
-        torch.save({**state, "stage": dict(stage)}, tmp)
+        torch.save(contents, tmp)
     LOG.info("kept stage %d (fraction %g) at update %d (%d env steps): %s", stage["k"], stage["fraction"],
              stage["update"], stage["env_steps"], path)
 
@@ -298,11 +334,11 @@ def write_metrics(path: Path, rows: list[dict]) -> None:
         pd.DataFrame(rows).to_parquet(tmp, index=False)
 
 
-def save_checkpoint(path: Path, cfg: EfishConfig, compute: Compute, learner: Learner, env: VecEnv, carry: dict,
-                    generator: torch.Generator, update: int, rows: list[dict]) -> dict:
+def checkpoint_state(cfg: EfishConfig, compute: Compute, learner: Learner, env: VecEnv, carry: dict,
+                     generator: torch.Generator, update: int, rows: list[dict]) -> dict:
     """Everything a resumed run needs to continue bit for bit, the config it ran under and the precision it
-    computed in, written atomically (tensors on the CPU, so any device can resume it). Returns what it wrote
-    (CPU tensors may share memory with the live networks: use it before training goes on)."""
+    computed in (tensors on the CPU, so any device can resume it; they may share memory with the live networks:
+    write it before training goes on)."""
     state = {
         "architecture": learner.architecture, "config": training_config(cfg), "precision": compute.precision,
         "update": update, "metrics": rows,
@@ -312,10 +348,13 @@ def save_checkpoint(path: Path, cfg: EfishConfig, compute: Compute, learner: Lea
         "torch_rng": torch.get_rng_state(), "generator": generator.get_state(),
         "env": env.state_dict(), "carry": carry,
     }
-    state = _to_cpu(state)
+    return _to_cpu(state)
+
+
+def write_checkpoint(path: Path, state: dict) -> None:
+    """A checkpoint (:func:`checkpoint_state`, with the stage copies under ``stage_copies``), atomically."""
     with atomic_path(path) as tmp:
         torch.save(state, tmp)
-    return state
 
 
 def _to_cpu(obj):
