@@ -7,7 +7,15 @@ import pandas as pd
 import pytest
 from scipy import stats as sps
 
-from efish.analysis.stats import STAT_COLUMNS, dunnett_vs_control, mann_whitney, spearman, stars, wilcoxon_paired
+from efish.analysis.stats import (
+    STAT_COLUMNS,
+    dunnett_vs_control,
+    mann_whitney,
+    signed_rank_test,
+    spearman,
+    stars,
+    wilcoxon_paired,
+)
 
 
 def groups_table(rng, means=(0.0, 0.5, 1.5), n=12) -> pd.DataFrame:
@@ -63,6 +71,32 @@ def test_wilcoxon_pairs_by_key_whatever_the_row_order():
     assert out.loc["a", "statistic"] == pytest.approx(ref.statistic)
     assert out.loc["a", "p"] == pytest.approx(ref.pvalue)
     assert out.loc["a", "effect"] == pytest.approx(np.median(x - y)) and out.loc["a", "n"] == 12
+
+
+def integer_differences(rng, n: int) -> np.ndarray:
+    """Paired differences as food counts give them: small integers, so ties and zeros are common."""
+    return rng.integers(-4, 5, n).astype(np.float64)
+
+
+@pytest.mark.parametrize("alternative", ["two-sided", "less", "greater"])
+def test_signed_rank_test_equals_scipys_wilcoxon(alternative):
+    """The counted permutation branch (n <= 13 with ties or zeros) and every delegated case give scipy's
+    statistic and p, to the last bits: integer differences (ties, zeros, one sign only), half-integer ones
+    (average ranks of a tie across a zero), continuous ones (scipy's exact branch) and n past 13."""
+    rng = np.random.default_rng(11)
+    cases = [integer_differences(rng, n) for n in [*range(1, 12), 13, 15] for _ in range(4 if n < 12 else 1)]
+    cases += [np.abs(integer_differences(rng, 9)) + 1, np.array([0.5, -0.5, 0.0, 1.5, 1.5, -2.0]),
+              rng.normal(0.3, 1.0, 10), rng.normal(0.0, 1.0, 30)]
+    counted = 0
+    for d in cases:
+        if not np.any(d):
+            continue
+        ref = sps.wilcoxon(d, alternative=alternative)
+        statistic, p = signed_rank_test(d, alternative)
+        assert statistic == pytest.approx(float(ref.statistic), rel=1e-12, abs=0), d
+        assert p == pytest.approx(float(ref.pvalue), rel=1e-12, abs=1e-15), d
+        counted += d.size <= 13 and (np.any(d == 0) or np.unique(np.abs(d[d != 0])).size < np.count_nonzero(d))
+    assert counted > 25  # most cases took the counted branch
 
 
 def test_spearman_matches_scipy():

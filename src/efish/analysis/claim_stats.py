@@ -32,7 +32,7 @@ import pandas as pd
 from scipy import stats as sps
 
 from .inequality import theil_t
-from .stats import STAT_COLUMNS, wilcoxon_paired
+from .stats import STAT_COLUMNS, signed_rank_test, wilcoxon_paired
 
 
 # ------------------------------------------------------------------ paired tests
@@ -101,8 +101,8 @@ def tost_paired(diff: np.ndarray, margin: float) -> float:
     d = d[np.isfinite(d)]
     if d.size < 2:
         raise ValueError(f"fewer than 2 paired differences for an equivalence test ({d.size})")
-    lower = sps.wilcoxon(d + margin, alternative="greater", zero_method="wilcox").pvalue if np.any(d + margin) else 1.0
-    upper = sps.wilcoxon(d - margin, alternative="less", zero_method="wilcox").pvalue if np.any(d - margin) else 1.0
+    lower = signed_rank_test(d + margin, "greater")[1] if np.any(d + margin) else 1.0
+    upper = signed_rank_test(d - margin, "less")[1] if np.any(d - margin) else 1.0
     return float(max(lower, upper))
 
 
