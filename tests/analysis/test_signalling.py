@@ -58,6 +58,18 @@ def test_discrete_power_law_of_whole_steps():
     assert xmin_in_steps(12.0, 12.048) == 1 and xmin_in_steps(24.1, 12.048) == 3 and xmin_in_steps(0.0) == 1
 
 
+def test_fewer_alternatives_change_no_comparison():
+    """Comparing with the exponential alone (the C4 bootstrap) gives the full fit's alpha and R_exponential and
+    leaves the lognormal's numbers NaN."""
+    from scipy import stats as sps
+
+    x = sps.zipf(2.2).rvs(5_000, random_state=4)
+    full, alone = fit_power_law(x, 1, discrete=True), fit_power_law(x, 1, discrete=True, alternatives=("exponential",))
+    assert (alone["alpha"], alone["R_exponential"], alone["p_exponential"]) == (
+        full["alpha"], full["R_exponential"], full["p_exponential"])
+    assert np.isnan(alone["R_lognormal"]) and np.isnan(alone["p_lognormal"]) and np.isfinite(full["R_lognormal"])
+
+
 def test_lognormal_data_prefer_lognormal():
     x = np.random.default_rng(0).lognormal(mean=4.0, sigma=0.8, size=10_000)
     fit = fit_power_law(x)

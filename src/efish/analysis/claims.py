@@ -165,7 +165,7 @@ POWER_LAW, IDIS = analysis_table("signalling", "wide2", "power_law"), analysis_t
 
 def _r_exponential(idi_steps: np.ndarray, xmin: float) -> float:
     """The discrete power law's normalised loglikelihood ratio against the exponential (the bootstrap's statistic)."""
-    fit = fit_power_law(idi_steps, xmin, discrete=True)
+    fit = fit_power_law(idi_steps, xmin, discrete=True, alternatives=("exponential",))
     return fit["R_exponential"]
 
 
