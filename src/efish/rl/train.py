@@ -269,12 +269,12 @@ def stages_to_write(out: Path, plan: list[dict], state: dict | None, cfg: EfishC
     passed = state.get(STAGE_COPIES, {})
     for stage in plan:
         path = out / stage_file(stage["k"])
-        copy = passed.get(stage["k"], {}).get("stage", {})
+        copied = passed.get(stage["k"], {}).get("stage", {})  # the record of the checkpoint's copy, if any
         if _stage_is_kept(path, stage, cfg, compute):
             continue
         if stage["update"] > state["update"]:
             todo.append(stage)
-        elif _same_stage(copy, stage):
+        elif _same_stage(copied, stage):
             write_stage(path, passed[stage["k"]])
         elif stage["update"] == state["update"]:
             write_stage(path, stage_contents(state, stage))
