@@ -31,7 +31,7 @@ VERDICT_COLOURS = {"holds": "#009E73", "weaker": "#E69F00", "fails": "#D55E00", 
                    "not run": tint(NEUTRAL_COLOUR, 0.5)}
 #: Side of one part's axes, inches; at most this many axes per row.
 AXES_IN, COLUMNS = (2.4, 2.0), 4
-TITLE_CHARS = 40  # a longer part label wraps
+TITLE_CHARS = 34  # a longer part label wraps (40 ran past the last column's axes)
 PAPER_SHADE = tint(VERDICT_COLOURS["holds"], 0.85)
 
 
