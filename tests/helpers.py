@@ -8,6 +8,8 @@ only holds fixtures. Configs are composed once per distinct override set
 from __future__ import annotations
 
 import functools
+import hashlib
+from collections.abc import Iterable
 from pathlib import Path
 
 import numpy as np
@@ -174,6 +176,42 @@ def _episodes_of(steps):
                 mean_nn_dist_cm=("dist_agent_cm", "mean"), **{"return": ("reward", "sum")}, steps=("t", "size"),
                 terminated=("terminated", "any"), success=("success", "any"))
     return out.reset_index()
+
+
+def _canonical_cell(value) -> str:
+    """One cell of a list or nested column as text that is equal exactly when the values are: arrays and lists
+    element by element (an array read back from Parquet equals the list written), NaN equal to NaN, -0.0 to 0.0."""
+    if isinstance(value, np.ndarray | list | tuple):
+        return "[" + ",".join(_canonical_cell(v) for v in value) + "]"
+    if isinstance(value, dict):
+        return "{" + ",".join(f"{k!r}:{_canonical_cell(v)}" for k, v in sorted(value.items())) + "}"
+    if isinstance(value, float | np.floating):
+        return "nan" if np.isnan(value) else repr(float(value) + 0.0)  # + 0.0 turns -0.0 into 0.0
+    return repr(value.item() if isinstance(value, np.generic) else value)
+
+
+def _canonical_column(column: pd.Series) -> pd.Series:
+    """A column that ``pd.util.hash_pandas_object`` can hash and whose hash follows the values: floats with one
+    NaN and one zero, object columns holding lists or arrays (e.g. conditions.parquet) as canonical text."""
+    if pd.api.types.is_float_dtype(column.dtype) and isinstance(column.dtype, np.dtype):
+        values = column.to_numpy() + column.dtype.type(0.0)  # -0.0 + 0.0 == +0.0
+        return pd.Series(np.where(np.isnan(values), column.dtype.type(np.nan), values), name=column.name)
+    if column.dtype == object and any(isinstance(v, np.ndarray | list | tuple | dict) for v in column):
+        return column.map(_canonical_cell)
+    return column
+
+
+def table_digest(table: pd.DataFrame, ignore: Iterable[str] = ()) -> str:
+    """sha256 of a table's column names and values, the columns in sorted order and ``ignore`` left out.
+
+    Two tables get the same digest exactly when they hold the same values in the same rows: NaN equals NaN and
+    -0.0 equals 0.0 (as in ``pd.testing.assert_frame_equal``), and list or array cells compare element by element.
+    The index is not part of it."""
+    columns = sorted(set(table.columns) - set(ignore))
+    digest = hashlib.sha256(repr([(c, str(table[c].dtype)) for c in columns]).encode())
+    for c in columns:
+        digest.update(pd.util.hash_pandas_object(_canonical_column(table[c]), index=False).to_numpy().tobytes())
+    return digest.hexdigest()
 
 
 REPO = Path(__file__).resolve().parents[1]

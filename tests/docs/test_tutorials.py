@@ -26,69 +26,17 @@ import signal
 import subprocess
 import sys
 import time
-from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
 
 from ..helpers import scratch_workflow, smoke_env
+from ..markdown import FENCE_LINE, Block, blocks, commands
 
 REPO = Path(__file__).resolve().parents[2]
 TUTORIALS = REPO / "docs" / "tutorials"
 PAGES = sorted(TUTORIALS.glob("*.md"))
-RUN = ("bash", "python")
-SHOWN = ("text", "console")
 BLOCK_TIMEOUT_S = 900
-
-FENCE = re.compile(r"^(?P<indent>[ \t]*)(?P<fence>`{3,})(?P<info>[^`\n]*)\n(?P<body>.*?)^(?P=indent)(?P=fence)[ \t]*$",
-                   re.M | re.S)
-FENCE_LINE = re.compile(r"^[ \t]*`{3,}", re.M)
-TITLE = re.compile(r'\btitle\s*=\s*"(?P<title>[^"]*)"')
-
-
-@dataclass(frozen=True)
-class Block:
-    """One fenced code block of a page: its language, its ``title`` (None: untitled), its text and its line."""
-
-    page: str
-    line: int
-    lang: str
-    title: str | None
-    code: str
-
-    @property
-    def kind(self) -> str:
-        """``write`` (a titled block: a file), ``run`` (bash, python), ``shown`` (output) or ``unknown``."""
-        if self.title is not None:
-            return "write"
-        return "run" if self.lang in RUN else "shown" if self.lang in SHOWN else "unknown"
-
-    @property
-    def where(self) -> str:
-        return f"docs/tutorials/{self.page}:{self.line}"
-
-
-def blocks(page: Path) -> list[Block]:
-    """The fenced code blocks of ``page`` in order (a block indented under an admonition or a tab is dedented)."""
-    text = page.read_text()
-    found = []
-    for m in FENCE.finditer(text):
-        info, indent = m["info"].strip(), m["indent"]
-        lang = info.split()[0].lstrip(".").lower() if info else ""
-        title = TITLE.search(info)
-        body = "".join(line[len(indent):] if line.startswith(indent) else line.lstrip(" \t")
-                       for line in m["body"].splitlines(keepends=True))
-        found.append(Block(page.name, text.count("\n", 0, m.start()) + 1, lang,
-                           title["title"] if title else None, body))
-    return found
-
-
-def commands(code: str) -> list[str]:
-    """The logical lines of a shell block (backslash continuations joined, comments and blank lines dropped)."""
-    joined = re.sub(r"\\\n\s*", " ", code)
-    return [line.strip() for line in joined.splitlines() if line.strip() and not line.strip().startswith("#")]
-
-
 def edits_source(page_blocks: list[Block]) -> bool:
     """Whether a page writes into the package (``src/``): then it runs on its own copy of the sources."""
     return any((b.title or "").startswith("src/") or (b.lang == "bash" and "src/efish/" in b.code)

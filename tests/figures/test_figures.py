@@ -167,3 +167,30 @@ def test_efish_figure_rejects_an_unknown_figure_in_one_line(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert err.startswith("efish: error: unknown figure 'fig99'") and "\n" not in err
     assert not (tmp_path / "f").exists()
+
+
+def rendered_text(rst: str) -> tuple[str, list[str]]:
+    """The plain text docutils renders from ``rst`` and its system messages (warnings and errors)."""
+    import io
+
+    from docutils.core import publish_doctree
+
+    stream = io.StringIO()
+    tree = publish_doctree(rst, settings_overrides={"report_level": 2, "halt_level": 5, "warning_stream": stream})
+    return " ".join(tree.astext().split()), stream.getvalue().splitlines()
+
+
+@pytest.mark.parametrize("caption", ["colour = |E| over the free-space |E|", "*x* and name_ and a `b` \\ c",
+                                     "o marks the start, * each pellet eaten", "plain text"])
+def test_a_report_caption_renders_as_written(caption):
+    from efish.figures.panel import rst_text
+
+    assert rendered_text(rst_text(caption)) == (caption, [])
+    if "|" in caption:  # the defect the escaping fixes: unescaped, |E| is an undefined substitution
+        assert rendered_text(caption)[1]
+
+
+def test_every_panel_caption_renders_in_the_report_as_written():
+    for key, panel in PANELS.items():
+        text, messages = rendered_text(f"- **{key}**: {panel.report_caption}")
+        assert messages == [] and text == f"{key}: {' '.join(panel.caption.split())}", key

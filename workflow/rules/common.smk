@@ -380,8 +380,9 @@ def figure_outputs(figure, run=RULE_RUN):
 
 
 def figure_legend(figure):
-    """(panel, caption, tables) of every panel of ``figure`` drawn at this scale, for the report's captions."""
-    return [(p.name, p.caption, ", ".join(f"``{path}``" for path in p.inputs.values()) or "none (a schematic)")
+    """(panel, caption, tables) of every panel of ``figure`` drawn at this scale, for the report's captions (reST:
+    the caption escaped, the tables as literals)."""
+    return [(p.name, p.report_caption, ", ".join(f"``{path}``" for path in p.inputs.values()) or "none (a schematic)")
             for p in FIGURE_PANELS[figure]]
 
 

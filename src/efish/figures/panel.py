@@ -12,6 +12,7 @@ composes a config of its own. A schematic panel reads nothing (``inputs={}``).
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -25,6 +26,17 @@ Tables = dict[str, pd.DataFrame]
 def conditions_key(assay: str) -> str:
     """The key under which a panel's tables hold the conditions table of ``assay``: ``conditions/<assay>``."""
     return f"conditions/{assay}"
+
+
+#: Characters that start inline markup in reStructuredText (``|E|`` would be a substitution reference, ``*x*``
+#: emphasis, ``name_`` a link) and the backslash that escapes them.
+_RST_MARKUP = re.compile(r"([\\`*_|])")
+
+
+def rst_text(text: str) -> str:
+    """``text`` escaped for reStructuredText, so that it renders as written: Snakemake's report reads captions as
+    reST, where a plain ``|E|`` is an undefined substitution and the caption loses it."""
+    return _RST_MARKUP.sub(r"\\\1", text)
 
 
 @dataclass(frozen=True)
@@ -45,6 +57,11 @@ class Panel:
     @property
     def key(self) -> str:
         return f"{self.figure}/{self.name}"
+
+    @property
+    def report_caption(self) -> str:
+        """The caption as the report's reST text (:func:`rst_text`): it renders exactly as :attr:`caption` reads."""
+        return rst_text(self.caption)
 
     def _parsed(self, kind: str) -> set[str]:
         return {t.assay for path in self.inputs.values() if (t := layout.parse_table(path)) and t.kind == kind}
