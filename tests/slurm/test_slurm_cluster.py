@@ -101,7 +101,7 @@ def slurm_targets(local: Path) -> list[str]:
     job of each rule that writes none: a figure, a clip. The other figures and clips repeat those rules on other
     tables, and the contact sheet waits for every figure; leaving them to the local run keeps the SLURM run (about
     12 s a job here: each job parses the workflow again) to 61 of the DAG's 72 jobs."""
-    run = Run("smoke", results_root=Path("results"), figures_root=Path("figures"))
+    run = Run("smoke")  # paths relative to the workflow's folder
     tables = sorted(str(p.relative_to(local)) for p in (local / run.results).glob("**/*.parquet"))
     return [*tables, str(run.bench / "bench_physics.json"), str(run.page("fig2", "png")), str(run.clip("homing"))]
 
