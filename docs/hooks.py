@@ -83,8 +83,8 @@ def config_reference() -> str:
 
 def tables_reference() -> str:
     """Markdown: the columns of every rollout table (``efish schema``) and of the claims tables."""
-    from efish.analysis.claim_parts import PART_COLUMNS, ROW_COLUMNS
     from efish.analysis.selection import RANKING_COLUMNS
+    from efish.claims.verdicts import PART_COLUMNS, ROW_COLUMNS
     from efish.rollout.schema import COLUMNS, HIDDEN_UNITS
 
     out = []

@@ -9,10 +9,10 @@ import math
 import pandas as pd
 import pytest
 
-from efish.analysis.claim_parts import PART_COLUMNS, ROW_COLUMNS
+from efish.claims.verdicts import PART_COLUMNS, ROW_COLUMNS
 from efish.cli import ReturnLog, _parser, _recipe_override, main
 
-from .analysis.test_claims_stages import STEPS, stage_parts
+from .claims.test_claims_stages import STEPS, stage_parts
 
 
 def test_the_training_log_never_prints_nan():
@@ -37,7 +37,7 @@ def seed_run(tmp_path, monkeypatch):
     """A run folder with a ranking (seed 3 selected, then 1 and 7) and the claims tables of seeds 1 and 7; the
     selected seed's claims are a fixed table and its parts one row per claim (claims_and_parts is replaced: these
     tests are about the CLI)."""
-    from efish.analysis import claims
+    from efish import claims
 
     def fixed(results, cfg):
         table = claims_rows({"C1": "holds", "C9": "holds"})
@@ -187,7 +187,7 @@ def test_efish_claims_by_stage_refuses_bad_stages_in_one_line_and_writes_nothing
 
 
 def test_compare_claims_shows_each_runs_seeds_agree_and_a_dash_without(tmp_path, capsys):
-    from efish.analysis.claims_seeds import with_seed_verdicts
+    from efish.claims.seeds import with_seed_verdicts
 
     with_seeds = with_seed_verdicts(claims_rows({"C9": "holds"}), {1: claims_rows({"C9": "holds"})}, 3)
     (tmp_path / "new").mkdir()

@@ -21,9 +21,9 @@ from .layout import (
 
 
 def run_claims(args, cfg, started) -> None:
-    from .analysis import claims
-    from .analysis.claims_report import claims_markdown
-    from .analysis.claims_stages import trend_lines
+    from . import claims
+    from .claims.report import claims_markdown
+    from .claims.stages import trend_lines
     from .io import read_parquet, write_parquet_tables, write_text_atomic
 
     results = args.results or run_of(cfg, args.overrides).results
@@ -36,7 +36,7 @@ def run_claims(args, cfg, started) -> None:
     header = (f"Claims of the paper at scale {cfg.scale.name} (run {results.name}), "
               f"{started.strftime('%Y-%m-%d %H:%M UTC')}")
     if seeds is not None:
-        from .analysis.claims_seeds import with_seed_verdicts
+        from .claims.seeds import with_seed_verdicts
 
         selected, others = seeds
         table = with_seed_verdicts(table, others, selected)
@@ -120,8 +120,8 @@ def _read_stage(k: int, where: Path):
 
 
 def run_claims_by_stage(args, cfg, started) -> None:
-    from .analysis.claims_report import claims_markdown
-    from .analysis.claims_stages import claims_by_stage, stage_trends, trend_lines
+    from .claims.report import claims_markdown
+    from .claims.stages import claims_by_stage, stage_trends, trend_lines
     from .figures.learning import plot_claims_by_stage
     from .io import read_parquet, write_parquet_tables, write_text_atomic
 
@@ -153,7 +153,7 @@ def run_claims_by_stage(args, cfg, started) -> None:
 
 
 def run_compare_claims(args, cfg, started) -> None:
-    from .analysis.claims_report import compare_claims, load_claims
+    from .claims.report import compare_claims, load_claims
 
     (name_a, a), (name_b, b) = load_claims(args.a), load_claims(args.b)
     print(compare_claims(a, b, (name_a, name_b)).to_string(index=False))

@@ -6,11 +6,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from efish.analysis.claims_stages import claims_by_stage, stage_trends
+from efish.claims.stages import claims_by_stage, stage_trends
 from efish.figures.learning import VERDICT_COLOURS, claims_by_stage_figure, plot_claims_by_stage
 from efish.figures.style import panel_style
 
-from ..analysis.test_claims_stages import STEPS, stage_parts
+from ..claims.test_claims_stages import STEPS, stage_parts
 
 PARTS = {("C3", "alignment"): (-1, [-0.1, -0.2, -0.3, -0.4]),
          ("C10", "K off (equivalent)"): (0, [1.5, 0.9, 0.4, 0.05]),

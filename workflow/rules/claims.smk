@@ -1,4 +1,4 @@
-# Claims: one job reading every table the claims registry (efish.analysis.claims.CLAIMS) names that this scale
+# Claims: one job reading every table the claims registry (efish.claims.CLAIMS) names that this scale
 # produces, writing claims.parquet, claim_parts.parquet (one row per tested part) and claims.md. A claim whose tables the scale does not produce is written as
 # "not run" with the missing table named (efish claims never fails on it).
 # Verdicts across seeds. Each top seed other than the selected one gets its own claims table from its rerun assays

@@ -8,7 +8,7 @@ import shlex
 import sys
 from pathlib import Path
 
-from efish.analysis.claims import claim_tables, produced_tables
+from efish.claims import claim_tables, produced_tables
 from efish.analysis.registry import ANALYSES, analyses_for, tables_written
 from efish._numba_cache import source_digest
 from efish.config import ConfigError, compose, config_dir, run_name

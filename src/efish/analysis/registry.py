@@ -8,8 +8,8 @@ compute function passes the composed config's values (``cfg.analysis``,
 centre) to the pure functions of the ``efish.analysis`` modules; a statistic
 table (:attr:`Analysis.stats`) carries the columns of
 :data:`efish.analysis.stats.STAT_COLUMNS`. A table whose input columns the
-rollout does not record yet (``bite_target``, the ``err_*_rad`` angles) is one
-NaN row whose ``reason`` names them, so every declared table is always written.
+rollout tables lack (a run recorded before a column existed) is one NaN row
+whose ``reason`` names them, so every declared table is always written.
 
 >>> [a.name for a in analyses_for("homing", tables_written(AssayConfig(name="homing")))]
 ['homing']
@@ -60,7 +60,6 @@ from .signalling import (
 from .stats import STAT_COLUMNS, dunnett_by_measure, spearman
 
 Tables = dict[str, pd.DataFrame]
-#: Tables every assay writes; ``hidden`` only with ``assay.record_hidden`` (a key the assays issue adds).
 #: Per-episode measures of :func:`efish.analysis.behaviour.episode_summary` compared between conditions.
 SUMMARY_MEASURES = ["food_total", "theil_t", "eod_probability", "mean_nn_dist_cm", "bites"]
 #: Per-agent-episode measures of :func:`efish.analysis.dynamics.dynamics_table` compared between conditions.

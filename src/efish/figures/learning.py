@@ -6,10 +6,10 @@ line at 0 and the paper's side of it shaded; the y label names that side
 ("effect (paper: > 0)"; "paper: 0", a part the paper reports as no
 difference, and "paper: ≠ 0", any difference, shade nothing). The title is
 ``C3: <part>`` and the part's trend
-(:func:`efish.analysis.claims_stages.stage_trends`). A part with no finite
+(:func:`efish.claims.stages.stage_trends`). A part with no finite
 effect at any stage says so on its axes instead of drawing nothing.
 
-Reads the stacked table of :func:`efish.analysis.claims_stages.claims_by_stage`;
+Reads the stacked table of :func:`efish.claims.stages.claims_by_stage`;
 no simulator, no torch.
 """
 
@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..analysis.claims_stages import TRENDS, stage_trends
+from ..claims.stages import TRENDS, stage_trends
 from .render import save_figure
 from .style import NEUTRAL_COLOUR, missing, panel_style, tint
 

@@ -4,32 +4,36 @@ other way round; missing tables give ``not run`` with a reason; reruns are ident
 
 from __future__ import annotations
 
+import re
 import zlib
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from efish.analysis import claims as cl
+from efish import claims as cl
 from efish.analysis.behaviour import (
     episode_summary,
     food_per_agent_episode,
     food_vs_size,
     theil_per_episode,
 )
-from efish.analysis.claim_parts import PART_COLUMNS, ROW_COLUMNS, bootstrap_ci, combined_verdict, judge, part_rows
-from efish.analysis.claims_report import claims_markdown, compare_claims, load_claims
 from efish.analysis.dynamics_tests import power_near_far, power_tests, size_tests
 from efish.analysis.interactions import size_role_tests
 from efish.analysis.onepatch import reach_tests
 from efish.analysis.registry import run
 from efish.analysis.signalling import fit_power_law
 from efish.analysis.stats import spearman
+from efish.claims import fig2, fig3, fig4, fig5, fig6
+from efish.claims.context import Claim
+from efish.claims.report import claims_markdown, compare_claims, load_claims
+from efish.claims.statistics import bootstrap_ci
+from efish.claims.verdicts import PART_COLUMNS, ROW_COLUMNS, combined_verdict, judge, part_rows
 from efish.cli import main
 from efish.config.recorded import recorded_conditions
 from efish.layout import analysis_table, assay_table
 
-from ..helpers import cfg_with, conditions_of, rollout_tables
+from ..helpers import REPO, cfg_with, conditions_of, rollout_tables
 
 CFG = cfg_with("analysis.claims_resamples=40", "analysis.claims_fit_resamples=4")
 A, R = analysis_table, assay_table
@@ -403,8 +407,8 @@ def c21(flip):
             A("dynamics", "wide2", "power_tests"): power_tests(near_far, dims, steps)}
 
 
-BUILDERS = {f"C{i}": f for i, f in enumerate([c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, c11, c12, c13, c14, c15,
-                                                c16, c17, c18, c19, c20, c21], start=1)}
+#: Per registered claim, the builder of its planted tables above (``c7`` for C7).
+BUILDERS = {cid: globals()[cid.lower()] for cid in cl.CLAIMS}
 
 
 # Claims whose planted headline statistic is the same in every episode, so its interval has no width: C13's layouts
@@ -413,8 +417,20 @@ CONSTANT_HEADLINE = {"C13"}
 
 
 # -------------------------------------------------------------------- tests
-def test_every_claim_of_claims_md_is_registered_with_a_builder():
-    assert list(cl.CLAIMS) == [f"C{i}" for i in range(1, 22)] == list(BUILDERS)
+def test_the_registry_lists_the_claims_of_the_docs_in_the_paper_order():
+    listed = re.findall(r"^\| \[(C\d+)\]\(#c\d+\) \|", (REPO / "docs/claims/index.md").read_text(), re.M)
+    assert listed and list(cl.CLAIMS) == listed
+    assert [int(c[1:]) for c in cl.CLAIMS] == sorted(int(c[1:]) for c in cl.CLAIMS)
+
+
+def test_every_claim_a_figure_module_defines_is_registered_once_under_its_figure():
+    defined = [(name, obj) for module in (fig2, fig3, fig4, fig5, fig6)
+               for name, obj in vars(module).items() if isinstance(obj, Claim)]
+    assert sorted(c.id for _, c in defined) == sorted(cl.CLAIMS)
+    for name, c in defined:
+        assert cl.CLAIMS[c.id] is c and name == c.id.lower()
+        # fig5's module holds the claims of Fig 5: the panel's figure number is the module's
+        assert c.compute.__module__ == f"efish.claims.fig{c.panel[0]}", (c.id, c.panel)
 
 
 @pytest.mark.parametrize("cid", list(BUILDERS))

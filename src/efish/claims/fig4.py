@@ -1,7 +1,6 @@
 """The claims of Fig 4 (C10-C13): ablations, collective sensing, muting, food layouts.
 
-Registered in :data:`efish.analysis.claim_parts.CLAIMS` on import
-(:mod:`efish.analysis.claims` imports this module). Conditions of one assay
+Conditions of one assay
 share their episode seeds, so they are compared paired over episodes with a
 Holm correction over the conditions compared with the same control; "no
 difference" parts are equivalence tests; food parts are not decidable while
@@ -20,20 +19,10 @@ import numpy as np
 import pandas as pd
 
 from ..layout import analysis_table, assay_table
-from .claim_parts import (
-    Context,
-    Outcome,
-    Part,
-    ceiling,
-    claim,
-    mann_whitney_part,
-    margin_for,
-    mean_diff,
-    paired_part,
-    present,
-    spearman_part,
-)
-from .claim_stats import excess_theil_per_episode, welch_tost
+from .context import Context, claim
+from .parts import ceiling, mann_whitney_part, margin_for, paired_part, present, spearman_part
+from .statistics import excess_theil_per_episode, mean_diff, welch_tost
+from .verdicts import Outcome, Part
 
 # ablation conditions are named by the receptor classes left on (config/assay/ablation4.yaml)
 ALL_ON, M_OFF, A_OFF, K_OFF = "M_A_K", "A_K", "M_K", "M_A"

@@ -8,7 +8,8 @@ import pandas as pd
 import pytest
 from scipy import stats as sps
 
-from efish.analysis.claim_stats import (
+from efish.analysis.inequality import theil_t
+from efish.claims.statistics import (
     at_ceiling,
     equivalence_margin,
     excess_theil,
@@ -19,7 +20,6 @@ from efish.analysis.claim_stats import (
     tost_paired,
     tost_unpaired,
 )
-from efish.analysis.inequality import theil_t
 
 
 def test_holm_matches_the_step_down_definition_and_skips_nan():

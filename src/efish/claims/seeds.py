@@ -33,10 +33,10 @@ from collections.abc import Mapping
 
 import pandas as pd
 
+from .verdicts import VERDICTS
+
 __all__ = ["SEED_COLUMNS", "VERDICTS", "agreement", "flip_sentence", "with_seed_verdicts"]
 
-#: The claims' verdicts, in the order counts are listed.
-VERDICTS = ("holds", "weaker", "fails", "not decidable", "not run")
 #: The columns :func:`with_seed_verdicts` adds, right after ``verdict``.
 SEED_COLUMNS = ("seed_verdicts", "seeds_agree")
 #: How a verdict reads after a count of seeds ("2/3 hold").
@@ -105,7 +105,7 @@ def with_seed_verdicts(selected: pd.DataFrame, others: Mapping[int, pd.DataFrame
     """The selected seed's claims table with ``seed_verdicts`` and ``seeds_agree`` after ``verdict``.
 
     ``selected``: the selected seed's table (the columns of
-    :data:`efish.analysis.claim_parts.ROW_COLUMNS`); ``others``: the other top
+    :data:`efish.claims.verdicts.ROW_COLUMNS`); ``others``: the other top
     seeds' tables by seed number, in the order they are to be listed (the
     ranking's). A claim absent from another seed's table counts as ``not run``
     there; claims only another seed has are ignored. A table without a claim or

@@ -1,5 +1,10 @@
-"""The statistics the claims' revised rules need (docs/claims/index.md) that no analysis table holds.
+"""The statistics of the claims' rules (docs/claims/index.md) that no analysis table holds.
 
+- :func:`bootstrap_ci`: a percentile interval over resampled units (episodes),
+  each unit's rows kept together, optionally within strata (conditions).
+- :func:`ols`, :func:`slope`, :func:`wilcoxon_vs`: an OLS slope with its p, a
+  one-sample Wilcoxon; and the statistics a bootstrap recomputes per resample
+  (:func:`median_diff`, :func:`mean_diff`, :func:`median_minus`, :func:`rho_of`).
 - :func:`paired_vs_control`: every condition against a control, paired over
   the episodes they share (Wilcoxon signed-rank), Holm-corrected over the
   conditions: the paired counterpart of Dunnett's many-to-one test. Conditions
@@ -25,14 +30,118 @@
 from __future__ import annotations
 
 import functools
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 import pandas as pd
 from scipy import stats as sps
 
-from .inequality import theil_t
-from .stats import STAT_COLUMNS, signed_rank_test, wilcoxon_paired
+from ..analysis.inequality import theil_t
+from ..analysis.stats import STAT_COLUMNS, signed_rank_test, wilcoxon_paired
+from .verdicts import NAN_CI
+
+
+# ------------------------------------------------------------------ bootstrap
+def bootstrap_ci(data: pd.DataFrame, stat: Callable[[pd.DataFrame], float], units: list[str],
+                 resamples: int, rng: np.random.Generator, strata: str | None = None,
+                 level: float = 0.95) -> tuple[float, float]:
+    """Percentile interval of ``stat`` over resamples of ``data``'s units (e.g. episodes), drawn with replacement.
+
+    A unit is a value of the ``units`` columns; every row of a drawn unit comes
+    along (an episode's agents stay together). With ``strata`` (e.g. condition)
+    each stratum's units are drawn separately, as many as it has. The resample
+    gets a ``_draw`` column numbering the drawn units, so that a statistic that
+    pairs rows can tell a unit drawn twice apart. NaN when fewer than half of the
+    resamples give a finite value (the statistic is undefined too often).
+    """
+    if data.empty or resamples < 1:
+        return NAN_CI
+    keys = ([strata] if strata else []) + list(units)
+    index = data.groupby(keys, sort=True, dropna=False).indices
+    groups = list(index.values())
+    stratum, _ = pd.factorize(pd.Series([k[0] for k in index] if strata else [0] * len(groups), dtype=object))
+    pools = [np.flatnonzero(stratum == s) for s in range(stratum.max() + 1)]
+    lengths = np.array([len(g) for g in groups])
+    values = np.empty(resamples)
+    for b in range(resamples):
+        chosen = np.concatenate([rng.choice(pool, size=len(pool), replace=True) for pool in pools])
+        rows = np.concatenate([groups[u] for u in chosen])
+        sample = data.iloc[rows].assign(_draw=np.repeat(np.arange(len(chosen)), lengths[chosen]))
+        values[b] = stat(sample)
+    finite = values[np.isfinite(values)]
+    if finite.size < resamples / 2:
+        return NAN_CI
+    tail = 100 * (1 - level) / 2
+    lo, hi = np.percentile(finite, [tail, 100 - tail])
+    return float(lo), float(hi)
+
+
+def ols(x, y) -> tuple[float, float, int]:
+    """Slope of y on x by least squares, its two-sided p (scipy.stats.linregress) and n; ValueError if undefined."""
+    xy = np.column_stack([np.asarray(x, np.float64), np.asarray(y, np.float64)])
+    xy = xy[np.all(np.isfinite(xy), axis=1)]
+    if len(xy) < 3:
+        raise ValueError(f"fewer than 3 finite points for a slope ({len(xy)})")
+    if np.ptp(xy[:, 0]) == 0:
+        raise ValueError("the regressor is constant")
+    if np.ptp(xy[:, 1]) == 0:
+        raise ValueError("the response is constant")
+    fit = sps.linregress(xy[:, 0], xy[:, 1])
+    return float(fit.slope), float(fit.pvalue), len(xy)
+
+
+def slope(x, y) -> float:
+    """The OLS slope alone (NaN where undefined): the bootstrap's statistic for :func:`ols`."""
+    try:
+        return ols(x, y)[0]
+    except ValueError:
+        return np.nan
+
+
+def wilcoxon_vs(values, reference: float) -> pd.Series:
+    """Two-sided Wilcoxon signed-rank test of ``values`` against a constant: a :mod:`.stats` row.
+
+    Effect = median of (value - reference). Built as a paired test against a
+    column of the constant, so the tie and degenerate rules are those of
+    :func:`efish.analysis.stats.wilcoxon_paired`.
+    """
+    v = np.asarray(values, np.float64)
+    v = v[np.isfinite(v)]
+    if v.size == 0:
+        raise ValueError("no finite value to test")
+    pair = np.arange(v.size)
+    long = pd.DataFrame({"pair": np.r_[pair, pair], "role": ["value"] * v.size + ["reference"] * v.size,
+                         "v": np.r_[v, np.full(v.size, float(reference))]})
+    return wilcoxon_paired(long, "v", "role", "reference", "pair").iloc[0]
+
+
+# ------------------------------------------------------------------ statistics a bootstrap recomputes
+def median_diff(value: str, group: str, a, b) -> Callable[[pd.DataFrame], float]:
+    """median(value | group == a) - median(value | group == b); NaN if a group is empty."""
+    def stat(d: pd.DataFrame) -> float:
+        x, y = d.loc[d[group] == a, value].dropna(), d.loc[d[group] == b, value].dropna()
+        return float(x.median() - y.median()) if len(x) and len(y) else np.nan
+    return stat
+
+
+def mean_diff(value: str, group: str, a, b) -> Callable[[pd.DataFrame], float]:
+    def stat(d: pd.DataFrame) -> float:
+        x, y = d.loc[d[group] == a, value].dropna(), d.loc[d[group] == b, value].dropna()
+        return float(x.mean() - y.mean()) if len(x) and len(y) else np.nan
+    return stat
+
+
+def median_minus(value: str, reference: float) -> Callable[[pd.DataFrame], float]:
+    return lambda d: float(np.nanmedian(d[value])) - reference if d[value].notna().any() else np.nan
+
+
+def rho_of(x: str, y: str) -> Callable[[pd.DataFrame], float]:
+    def stat(d: pd.DataFrame) -> float:
+        xy = d[[x, y]].astype(np.float64).dropna()
+        if len(xy) < 3 or xy[x].nunique() < 2 or xy[y].nunique() < 2:
+            return np.nan
+        return float(sps.spearmanr(xy[x], xy[y]).statistic)
+    return stat
 
 
 # ------------------------------------------------------------------ paired tests

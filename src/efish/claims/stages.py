@@ -3,7 +3,7 @@
 Training keeps the selected seed's policy at a few stages (fractions of its env
 steps); the claims' assays and analyses run again per stage and ``efish
 claims`` writes each stage's parts table (``claim_parts.parquet``,
-:data:`efish.analysis.claim_parts.PART_COLUMNS`). Here:
+:data:`efish.claims.verdicts.PART_COLUMNS`). Here:
 
 - :func:`claims_by_stage` stacks the stages' parts with each stage's env steps
   (and episodes per condition, so the table says when an early stage ran
@@ -11,7 +11,7 @@ claims`` writes each stage's parts table (``claim_parts.parquet``,
 - :func:`stage_trends` tests, per part, whether its effect moves toward the
   paper's sign, away from it, or neither (the test and why: its docstring);
 - :func:`trend_lines` says so in one line per claim, for claims.md
-  (:func:`efish.analysis.claims_report.along_training`).
+  (:func:`efish.claims.report.along_training`).
 
 Pure pandas and scipy: it reads tables, never the simulator.
 """
@@ -37,7 +37,7 @@ TREND_COLUMNS = ["claim", "part", "trend", "slope", "slope_ci_low", "slope_ci_hi
                  "reason"]
 #: A trend needs this many stages with a finite effect and interval (two points always lie on a line).
 MIN_STAGES = 3
-#: The claims' intervals are 95% bootstrap intervals (efish.analysis.claim_parts.bootstrap_ci): half-width / Z95
+#: The claims' intervals are 95% bootstrap intervals (efish.claims.statistics.bootstrap_ci): half-width / Z95
 #: is the normal approximation of the effect's standard error.
 Z95 = float(sps.norm.ppf(0.975))
 

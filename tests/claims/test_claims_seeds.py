@@ -6,9 +6,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from efish.analysis import claim_parts
-from efish.analysis.claim_parts import ROW_COLUMNS
-from efish.analysis.claims_seeds import VERDICTS, agreement, flip_sentence, with_seed_verdicts
+from efish.claims.seeds import agreement, flip_sentence, with_seed_verdicts
+from efish.claims.verdicts import ROW_COLUMNS
 
 
 def table(verdicts: dict[str, str], reason: str = "") -> pd.DataFrame:
@@ -18,10 +17,6 @@ def table(verdicts: dict[str, str], reason: str = "") -> pd.DataFrame:
                          "effect": np.linspace(0.1, 0.5, n), "ci_low": [0.0] * n, "ci_high": [1.0] * n,
                          "n": [8] * n, "p": [0.01] * n, "verdict": list(verdicts.values()), "reason": [reason] * n},
                         columns=ROW_COLUMNS)
-
-
-def test_the_vocabulary_is_the_claims_one():
-    assert set(VERDICTS) == set(claim_parts.VERDICTS)
 
 
 def test_agreeing_seeds_count_and_keep_the_reason():
@@ -93,7 +88,7 @@ def test_bad_tables_are_one_clear_error(others, message):
 
 
 def test_the_claims_page_shows_seeds_agree_beside_the_verdict_when_the_table_has_it():
-    from efish.analysis.claims_report import claims_markdown
+    from efish.claims.report import claims_markdown
 
     sel = table({"C1": "holds"})
     page = claims_markdown(with_seed_verdicts(sel, {1: table({"C1": "fails"})}, selected_seed=3), "header")

@@ -1,4 +1,4 @@
-"""The claims along training (efish.analysis.claims_stages): stages stacked in the claims' order with their env steps;
+"""The claims along training (efish.claims.stages): stages stacked in the claims' order with their env steps;
 a planted trend toward the paper's sign, away from it, none, a "no difference" part shrinking, too few stages; the
 weighted slope and its dispersion; the one-line summaries and claims.md's "Along training" section."""
 
@@ -11,9 +11,8 @@ import pandas as pd
 import pytest
 from scipy import stats as sps
 
-from efish.analysis.claim_parts import PART_COLUMNS
-from efish.analysis.claims_report import claims_markdown
-from efish.analysis.claims_stages import (
+from efish.claims.report import claims_markdown
+from efish.claims.stages import (
     STAGE_COLUMNS,
     TREND_COLUMNS,
     TRENDS,
@@ -22,6 +21,7 @@ from efish.analysis.claims_stages import (
     trend_lines,
     wls_slope,
 )
+from efish.claims.verdicts import PART_COLUMNS
 
 TOWARD, STABLE, AWAY, UNDECIDED = TRENDS
 STEPS = {1: 25_000, 2: 50_000, 3: 75_000, 4: 100_000}

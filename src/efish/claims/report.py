@@ -1,6 +1,6 @@
 """Claims tables for people: the markdown page of one run, and two runs side by side (``efish compare-claims``).
 
-A claims table is the output of :func:`efish.analysis.claims.claims_table`
+A claims table is the output of :func:`efish.claims.claims_table`
 (``results/{run}/claims/claims.parquet``).
 """
 
@@ -14,7 +14,17 @@ import pandas as pd
 
 from ..io import read_parquet
 from ..layout import CLAIMS_TABLE, RESULTS_ROOT, Run
-from .claim_parts import VERDICTS, markdown_table
+from .verdicts import VERDICTS
+
+
+def markdown_table(frame: pd.DataFrame) -> str:
+    """A GitHub markdown table of ``frame`` (cells as given; '|' escaped)."""
+    def cell(v) -> str:
+        return str(v).replace("|", "\\|").replace("\n", " ")
+
+    lines = ["| " + " | ".join(map(cell, frame.columns)) + " |", "|" + "---|" * len(frame.columns)]
+    lines += ["| " + " | ".join(cell(v) for v in row) + " |" for row in frame.itertuples(index=False)]
+    return "\n".join(lines) + "\n"
 
 
 def _num(x: float) -> str:
@@ -29,9 +39,9 @@ def _effects(table: pd.DataFrame) -> list[str]:
 
 def claims_markdown(table: pd.DataFrame, header: str, trends: Mapping[str, str] | None = None) -> str:
     """The claims table as markdown under a ``header`` line: claim, panel, statistic, effect [95% CI], n, p, verdict,
-    seeds_agree (when the table has it: the verdicts across the top seeds, :mod:`efish.analysis.claims_seeds`),
+    seeds_agree (when the table has it: the verdicts across the top seeds, :mod:`efish.claims.seeds`),
     reason (what docs/claims/results.md quotes and the Snakemake report shows); with ``trends`` (claim -> line,
-    :func:`efish.analysis.claims_stages.trend_lines`) the section :func:`along_training` after it."""
+    :func:`efish.claims.stages.trend_lines`) the section :func:`along_training` after it."""
     shown = pd.DataFrame({
         "claim": table["claim"], "panel": table["panel"], "statistic": table["statistic"],
         "effect [95% CI]": _effects(table), "n": table["n"], "p": [_num(p) for p in table["p"]],

@@ -1,0 +1,171 @@
+"""The claims of Fig 3 (C4-C9): EOD timing and rates, biting and food against size.
+
+Condition names are those of ``config/assay/<assay>.yaml``.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+import pandas as pd
+from scipy import stats as sps
+
+from ..analysis._tables import AGENT_EPISODE, eod_rate
+from ..analysis.signalling import EVENTS, fit_power_law, peri_event_rate
+from ..layout import analysis_table, assay_table
+from .context import Context, claim
+from .parts import (
+    from_row,
+    ols_part,
+    one_sample_part,
+    spearman_part,
+    stat_row,
+)
+from .statistics import median_minus, rho_of, slope
+from .verdicts import Outcome, Part
+
+POWER_LAW, IDIS = analysis_table("signalling", "wide2", "power_law"), analysis_table("signalling", "wide2", "idis")
+
+
+def _r_exponential(idi_steps: np.ndarray, xmin: float) -> float:
+    """The discrete power law's normalised loglikelihood ratio against the exponential (the bootstrap's statistic)."""
+    fit = fit_power_law(idi_steps, xmin, discrete=True, alternatives=("exponential",))
+    return fit["R_exponential"]
+
+
+@claim("C4", "3C,D", "IDIs are heavy-tailed, power-law-like", [POWER_LAW, IDIS])
+def c4(ctx: Context) -> list[Part]:
+    def compute() -> Outcome:
+        row = stat_row(ctx.table(POWER_LAW), source="agents")
+        if not bool(row.get("discrete", False)):
+            raise ValueError("the power_law table holds a continuous fit: rerun the signalling analysis")
+        xmin = float(row["xmin_steps"])
+        ids = ctx.table(IDIS)
+        ids = ids[ids["condition"] == row["condition"]] if "condition" in ids.columns else ids
+        ci = ctx.ci(ids, lambda d: _r_exponential(d["idi_steps"].to_numpy(np.float64), xmin),
+                    units_=("episode", "agent"), resamples=ctx.cfg.analysis.claims_fit_resamples)
+        note = f"alpha {float(row['alpha']):.3g}, xmin {xmin:g} steps" if np.isfinite(row["alpha"]) else ""
+        why = str(row.get("reason") or "")
+        return Outcome(float(row["R_exponential"]), float(row["p_exponential"]), int(row["n"]), +1, ci,
+                       "; ".join(r for r in (note, why) if r))
+    return [ctx.part("power law", "normalised loglikelihood ratio R of a discrete power law vs the exponential, "
+                     "IDIs in steps >= xmin (wide2; powerlaw discrete=True, as the authors); powerlaw's p", compute)]
+
+
+WIDE2_STEPS = assay_table("wide2", "steps")
+
+
+def _kruskal_eta(d: pd.DataFrame) -> tuple[float, float, int]:
+    """Kruskal-Wallis of ``rate`` over ``bin``: epsilon^2 = (H - k + 1) / (n - k), p, n; NaN when undefined."""
+    samples = [g.to_numpy() for _, g in d.groupby("bin")["rate"]]
+    n, k = sum(len(s) for s in samples), len(samples)
+    if k < 2 or n <= k or np.ptp(d["rate"]) == 0:
+        return np.nan, np.nan, n
+    h, p = sps.kruskal(*samples)
+    return float((h - k + 1) / (n - k)), float(p), n
+
+
+@claim("C5", "3E-G", "the EOD rate varies with distance to agent, food and wall", [WIDE2_STEPS])
+def c5(ctx: Context) -> list[Part]:
+    a = ctx.cfg.analysis
+
+    def compute(to: str) -> Outcome:
+        steps = ctx.table(WIDE2_STEPS)
+        dist = steps[f"dist_{to}_cm"].to_numpy(np.float64)
+        edges = np.linspace(0.0, getattr(a, f"{to}_range_cm"), a.rate_bins + 1)
+        frame = steps[AGENT_EPISODE].assign(rate=eod_rate(steps, a.rate_window, ctx.cfg.env.fps),
+                                            bin=np.clip(np.searchsorted(edges, dist, side="right") - 1, 0,
+                                                        a.rate_bins - 1))
+        frame = frame[np.isfinite(frame["rate"]) & (dist >= edges[0]) & (dist <= edges[-1])]
+        # one sample per agent-episode and bin (its mean rate): steps of one episode are not independent
+        per = frame.groupby([*AGENT_EPISODE, "bin"])["rate"].agg(["mean", "size"])
+        per = per[per["size"] >= a.min_samples]["mean"].rename("rate").reset_index()
+        if per.empty:
+            raise ValueError(f"no agent-episode has {a.min_samples} steps in a {to} distance bin")
+        eta, p, n = _kruskal_eta(per)
+        reason = "" if np.isfinite(p) else "fewer than 2 distance bins with data, or a constant rate"
+        return Outcome(eta, p, n, None, ctx.ci(per, lambda d: _kruskal_eta(d)[0]), reason)
+    stat = ("Kruskal-Wallis of the mean EOD rate per agent-episode and distance bin across the bins of "
+            "docs/methods/analyses.md#analysis-signalling (wide2); effect epsilon^2")
+    return [ctx.part(to, stat, functools.partial(compute, to)) for to in ("agent", "food", "wall")]
+
+
+@claim("C6", "3H-J", "the EOD rate rises around eating, builds before biting, rises around being bitten",
+       [WIDE2_STEPS])
+def c6(ctx: Context) -> list[Part]:
+    a = ctx.cfg.analysis
+    (e0, e1), (b0, b1) = a.claims_event_window, a.claims_baseline_window
+
+    def compute(event: str) -> Outcome:
+        if max(abs(e0), abs(e1), abs(b0), abs(b1)) > a.peri_window:
+            raise ValueError(f"the windows reach beyond analysis.peri_window = {a.peri_window} steps")
+        steps = ctx.table(WIDE2_STEPS)
+        # one peri-event curve per agent-episode: peri_event_rate averages within a condition, so each
+        # agent-episode becomes its own condition here
+        unit = steps["condition"].astype(str) + "|" + steps["episode"].astype(str) + "|" + steps["agent"].astype(str)
+        curves = peri_event_rate(steps.assign(condition=unit), event, a.peri_window, a.min_events, a.rate_window,
+                                 ctx.cfg.env.fps)
+        curves = curves[curves["n_agents"] > 0]
+        if curves.empty:
+            raise ValueError(f"no agent-episode has {a.min_events} or more '{event}' events")
+        lag = curves["lag"]
+        near = curves[(lag >= e0) & (lag <= e1)].groupby("condition")["mean_hz"].mean()
+        base = curves[(lag >= b0) & (lag <= b1)].groupby("condition")["mean_hz"].mean()
+        diff = (near - base).dropna().rename("diff").reset_index()
+        # back to the real condition and episode, so the interval resamples episodes within each condition
+        # (with the agent-episode as its own stratum, every resample would be the data itself: a zero-width CI)
+        parts = diff["condition"].str.rsplit("|", n=2)
+        diff["condition"], diff["episode"] = parts.str[0], parts.str[1]
+        return one_sample_part(ctx, diff, "diff", 0.0, +1)
+    stat = (f"median over agent-episodes of the mean EOD rate at lags [{e0}, {e1}] minus [{b0}, {b1}] steps of "
+            "the event (wide2); Wilcoxon vs 0")
+    return [ctx.part(event, stat, functools.partial(compute, event)) for event in EVENTS]
+
+
+def size_roles(ctx: Context, assay: str, measure: str, sizes: str) -> Outcome:
+    """The interactions analysis's Wilcoxon of chaser/biter vs chased/bitten size, interval over its events."""
+    row = stat_row(ctx.table(analysis_table("interactions", assay, "size_tests")), measure=measure)
+    events = ctx.table(analysis_table("interactions", assay, sizes))
+    ci = ctx.ci(events.dropna(subset=["size_difference"]), median_minus("size_difference", 0.0))
+    return from_row(row, +1, ci)
+
+
+@claim("C7", "3K,L; 5M,N", "larger agents bite smaller ones; the win ratio rises with size",
+       [analysis_table("interactions", a, t) for a in ("patchy4", "square2") for t in ("size_tests", "bite_sizes")]
+       + [analysis_table("behaviour", "patchy4", "win_ratio")])
+def c7(ctx: Context) -> list[Part]:
+    stat = "median biter minus bitten size over bites; Wilcoxon signed-rank"
+    parts = [ctx.part(f"biter larger, {assay}", stat, functools.partial(size_roles, ctx, assay, "bite",
+                                                                         "bite_sizes"))
+             for assay in ("patchy4", "square2")]
+
+    def win() -> Outcome:
+        return ols_part(ctx, ctx.table(analysis_table("behaviour", "patchy4", "win_ratio")), "size", "win_ratio", +1)
+    return parts + [ctx.part("win ratio slope, patchy4", "OLS slope of win ratio on size over agent-episodes", win)]
+
+
+@claim("C8", "3M,N", "larger agents eat more; Theil T of food tracks size inequality",
+       [analysis_table("behaviour", "patchy4", t) for t in ("food_vs_size", "food_per_agent", "theil")])
+def c8(ctx: Context) -> list[Part]:
+    def food() -> Outcome:
+        row = ctx.table(analysis_table("behaviour", "patchy4", "food_vs_size")).iloc[0]
+        per = ctx.table(analysis_table("behaviour", "patchy4", "food_per_agent"))
+        return from_row(row, +1, ctx.ci(per, lambda d: slope(d["size"], d["food_eaten"])))
+
+    def theil() -> Outcome:
+        return spearman_part(ctx, ctx.table(analysis_table("behaviour", "patchy4", "theil")), "size_theil_t",
+                             "theil_t", +1)
+    return [ctx.part("food ~ size", "OLS slope of food eaten on size over agent-episodes (patchy4)", food),
+            ctx.part("Theil ~ size Theil", "Spearman rho of episode Theil T(food) against Theil T(size) (patchy4; "
+                     "OLS was decided by one high-leverage episode)", theil)]
+
+
+@claim("C9", "3O", "size correlates positively with EOD rate",
+       [analysis_table("behaviour", "patchy4", t) for t in ("size_tests", "eod_probability")])
+def c9(ctx: Context) -> list[Part]:
+    def compute() -> Outcome:
+        row = stat_row(ctx.table(analysis_table("behaviour", "patchy4", "size_tests")), measure="eod_probability")
+        eod = ctx.table(analysis_table("behaviour", "patchy4", "eod_probability"))
+        return from_row(row, +1, ctx.ci(eod, rho_of("size", "eod_probability")))
+    return [ctx.part("rho", "Spearman rho(size, EOD probability) over agent-episodes (patchy4)", compute)]
