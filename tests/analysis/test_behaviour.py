@@ -121,18 +121,27 @@ def test_food_time_course_is_the_mean_cumulative_food():
 
 
 def test_reach_times_and_rates():
+    patch = (75.0, 75.0), 6.0  # the one-patch arena's: the centre of 150 x 150 cm, radius 6 cm
     x = np.r_[np.linspace(75 - 30, 75, 10), np.full(10, 10.0)]  # agent 0 walks to the patch; agent 1 stays away
     steps = steps_table(n_agents=2, x_cm=x, y_cm=75.0)
-    times = reach_times(steps)
+    times = reach_times(steps, *patch)
     assert times["reached"].tolist() == [True, False]
     t_in = int(np.argmax(np.abs(x[:10] - 75) <= 6.0))
     assert times.loc[0, "t_reach"] == t_in and np.isnan(times.loc[1, "t_reach"])
-    rates = reach_rates(steps).set_index("agent")
+    rates = reach_rates(steps, *patch).set_index("agent")
     assert rates.loc[0, "reach_rate"] == 1.0 and rates.loc[1, "reach_rate"] == 0.0
     assert "no episode reached" in rates.loc[1, "reason"]
-    bot = bot_reach_rates(steps, agent=0)
+    bot = bot_reach_rates(steps, *patch, agent=0)
     assert bot["agent"].tolist() == [0] and bot.loc[0, "median_t_reach"] == t_in
-    assert bot_reach_rates(steps, agent=5).loc[0, "reason"] == "no agent-episodes"
+    assert bot_reach_rates(steps, *patch, agent=5).loc[0, "reason"] == "no agent-episodes"
+
+
+def test_the_patch_is_the_callers():
+    """Reach is measured against the patch the caller names (the run's), not a built-in one."""
+    steps = steps_table(n_agents=1, x_cm=np.full(10, 20.0), y_cm=20.0)
+    assert reach_times(steps, (20.0, 20.0), 1.0)["reached"].tolist() == [True]
+    assert reach_times(steps, (75.0, 75.0), 6.0)["reached"].tolist() == [False]
+    assert reach_times(steps, (26.0, 20.0), 6.0)["reached"].tolist() == [True]  # at exactly the radius
 
 
 def test_missing_columns_are_named():

@@ -25,7 +25,7 @@ def test_default_config_matches_the_spec(default_cfg):
     ph, se = default_cfg.physics, default_cfg.sensors
     assert isinstance(default_cfg, EfishConfig)
     assert ph.eps0 == 8.854e-12 and ph.eod_charge_c == 1.11e-15 and ph.eod_half_separation_cm == 0.5
-    assert ph.agent_dipole_cm == 1.11e-23 and ph.pellet_dipole_cm == 1.11e-24
+    assert ph.agent_dipole_coulomb_metre == 1.11e-23 and ph.pellet_dipole_coulomb_metre == 1.11e-24
     assert ph.susceptibility == -0.5 and ph.agent_radius_cm == 1.0 and ph.pellet_radius_cm == 0.25
     assert ph.softening_m == 1e-5 and ph.image_order == 1 and ph.image_scale == 0.95
     assert (se.mormyromast.count, se.ampullary.count, se.knollenorgan.count) == (36, 24, 12)
@@ -240,3 +240,68 @@ def test_the_compose_cache_is_keyed_by_the_schema_this_process_loaded(tmp_path, 
     monkeypatch.setattr(composer, "_SOURCES_DIGEST", "the digest of another schema")
     composer.compose(["scale=smoke"])
     assert len(set((tmp_path / "cache" / "compose").glob("*.pkl"))) == 2  # composed afresh under its own key
+
+
+# ------------------------------------------------------------------ renamed keys (one release of the old names)
+@pytest.mark.parametrize(("old", "new", "value"), [("agent_dipole_cm", "agent_dipole_coulomb_metre", 2.5e-23),
+                                                   ("pellet_dipole_cm", "pellet_dipole_coulomb_metre", 3e-24)])
+def test_a_deprecated_key_on_the_command_line_warns_and_sets_the_new_one(old, new, value):
+    for _ in range(2):  # the second composition is served from the cache and warns all the same
+        with pytest.warns(FutureWarning, match=rf"^physics\.{old} is deprecated .* set physics\.{new} instead$"):
+            cfg = compose([f"physics.{old}={value}"])
+        assert getattr(cfg.physics, new) == value and getattr(cfg.physics, old) is None
+
+
+def test_a_deprecated_key_in_a_yaml_file_warns_and_sets_the_new_one(tmp_path, monkeypatch):
+    import shutil
+
+    tree = tmp_path / "config"
+    shutil.copytree(config_dir(), tree)
+    (tree / "physics" / "old_names.yaml").write_text("agent_dipole_cm: 2.0e-23\n")
+    monkeypatch.setenv("EFISH_CONFIG_DIR", str(tree))
+    with pytest.warns(FutureWarning, match="physics.agent_dipole_coulomb_metre"):
+        cfg = compose(["physics=old_names"])
+    assert cfg.physics.agent_dipole_coulomb_metre == 2.0e-23
+
+
+def test_a_deprecated_key_in_an_assay_condition_sets_the_new_one():
+    from efish.config.compose import compose_variants
+
+    with pytest.warns(FutureWarning, match="physics.pellet_dipole_coulomb_metre"):
+        cfgs = compose_variants(["assay=mute"], {"old": ["physics.pellet_dipole_cm=4e-24"], "plain": []})
+    assert cfgs["old"].physics.pellet_dipole_coulomb_metre == 4e-24
+    assert cfgs["plain"].physics.pellet_dipole_coulomb_metre == PhysicsConfig().pellet_dipole_coulomb_metre
+
+
+def test_a_deprecated_key_and_its_new_name_together_are_one_error():
+    with pytest.raises(ConfigError, match=r"^physics\.agent_dipole_cm and physics\.agent_dipole_coulomb_metre are "
+                                          r"both set: .*; set only physics\.agent_dipole_coulomb_metre$"):
+        compose(["physics.agent_dipole_cm=2e-23", "physics.agent_dipole_coulomb_metre=3e-23"])
+
+
+def test_a_config_recorded_under_the_old_names_reads_back_under_the_new(default_cfg):
+    """conditions.parquet of a run before the rename holds physics.agent_dipole_cm; a checkpoint's training config
+    too, and it still resumes (rl.train compares it under the current names)."""
+    import dataclasses
+    import json
+
+    from efish.config.recorded import config_json, from_json
+    from efish.config.schema import config_differences, training_config, with_current_key_names
+
+    record = json.loads(config_json(default_cfg))
+    physics = record["physics"]
+    physics["agent_dipole_cm"] = physics.pop("agent_dipole_coulomb_metre") * 2
+    physics.pop("pellet_dipole_coulomb_metre")
+    physics.pop("pellet_dipole_cm")
+    with pytest.warns(FutureWarning, match="physics.agent_dipole_coulomb_metre"):
+        cfg = from_json(json.dumps(record))
+    assert cfg.physics.agent_dipole_coulomb_metre == 2.22e-23
+    assert cfg.physics.pellet_dipole_coulomb_metre == PhysicsConfig().pellet_dipole_coulomb_metre
+
+    old_checkpoint = training_config(EfishConfig())
+    old_physics = old_checkpoint["physics"]
+    old_physics["agent_dipole_cm"] = old_physics.pop("agent_dipole_coulomb_metre")
+    old_physics["pellet_dipole_cm"] = old_physics.pop("pellet_dipole_coulomb_metre")
+    assert config_differences(old_checkpoint, training_config(EfishConfig()))  # as recorded: names differ
+    assert not config_differences(with_current_key_names(old_checkpoint), training_config(EfishConfig()))
+    assert dataclasses.asdict(EfishConfig())["physics"]["agent_dipole_cm"] is None

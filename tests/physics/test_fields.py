@@ -190,3 +190,50 @@ def test_monopole_field_rejects_bad_input(kwargs, name):
 def test_dipole_field_rejects_bad_input(kwargs, name):
     with pytest.raises(ValueError, match=name):
         dipole_field(**kwargs)
+
+
+# ------------------------------------------------------------- pairwise fields and polarisability
+def test_the_pairwise_fields_summed_over_sources_are_the_summed_fields():
+    """pairwise_* give each source's field at its own point; summed over the sources they are monopole_field and
+    dipole_field, whose per-source terms they share."""
+    from efish.physics.fields import pairwise_dipole_field, pairwise_monopole_field
+
+    rng = np.random.default_rng(3)
+    points, positions = rng.uniform(0, 0.7, (9, 2)), rng.uniform(0, 0.7, (5, 2))
+    charges, moments = rng.normal(0, 1e-15, 5), rng.normal(0, 1e-23, (5, 2))
+    pairs_q = pairwise_monopole_field(points[:, None], positions[None], charges)         # (9, 5, 2)
+    pairs_p = pairwise_dipole_field(points[:, None], positions[None], moments[None])     # (9, 5, 2)
+    assert pairs_q.shape == pairs_p.shape == (9, 5, 2)
+    np.testing.assert_allclose(pairs_q.sum(1), monopole_field(points, positions, charges), rtol=1e-13)
+    np.testing.assert_allclose(pairs_p.sum(1), dipole_field(points, positions, moments), rtol=1e-13)
+    for k in range(5):  # one source: the same numbers, pair by pair
+        np.testing.assert_allclose(pairs_q[:, k], monopole_field(points, positions[k:k + 1], charges[k:k + 1]),
+                                   rtol=1e-15)
+        np.testing.assert_allclose(pairs_p[:, k], dipole_field(points, positions[k:k + 1], moments[k:k + 1]),
+                                   rtol=1e-15)
+
+
+def test_the_pairwise_fields_broadcast_over_leading_axes():
+    from efish.physics.fields import pairwise_dipole_field, pairwise_monopole_field
+
+    points = np.zeros((3, 4, 2)) + [0.1, 0.0]        # one point, repeated over a [3, 4] batch
+    e = pairwise_monopole_field(points, [0.0, 0.0], Q, softening=0.0)
+    assert e.shape == (3, 4, 2) and np.all(e[..., 0] == e[0, 0, 0]) and e[0, 0, 0] == pytest.approx(K * Q / 0.1**2)
+    e = pairwise_dipole_field(points, np.zeros((3, 1, 2)), [P_EOD, 0.0], softening=0.0)
+    assert e.shape == (3, 4, 2) and e[0, 0, 0] == pytest.approx(2 * K * P_EOD / 0.1**3, rel=1e-12)
+
+
+def test_polarisability_is_4_pi_eps0_r3_chi_and_the_plans():
+    from efish.config import EfishConfig
+    from efish.physics import Scene, build_plan
+    from efish.physics.fields import polarisability
+
+    chi = PhysicsConfig().susceptibility
+    assert polarisability(0.01, chi) == pytest.approx(4 * np.pi * EPS0 * 0.01**3 * chi, rel=1e-14)
+    assert polarisability(0.01, chi) == pytest.approx(-5.56e-17, rel=1e-3)     # docs/model/physics.md#induction
+    assert polarisability(0.0025, chi) == pytest.approx(-8.69e-19, rel=1e-3)
+    radii = np.array([0.01, 0.0025])
+    np.testing.assert_allclose(polarisability(radii, chi), [polarisability(0.01, chi), polarisability(0.0025, chi)],
+                               rtol=1e-15)  # numpy's array power may differ from a float's in the last bit
+    plan = build_plan(EfishConfig(), Scene())
+    assert (plan.alpha_agent, plan.alpha_pellet) == (polarisability(0.01, chi), polarisability(0.0025, chi))

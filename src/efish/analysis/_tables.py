@@ -31,11 +31,6 @@ def require(df: pd.DataFrame, columns: Iterable[str], table: str = "table") -> N
         raise ValueError(f"{table} lacks columns {missing}")
 
 
-def wrap(a: np.ndarray) -> np.ndarray:
-    """Angles wrapped to [-pi, pi)."""
-    return (np.asarray(a, dtype=np.float64) + np.pi) % (2 * np.pi) - np.pi
-
-
 def nan_frame(reason: str, **values) -> pd.DataFrame:
     """One row of NaN statistics that says why (the degenerate-input contract of every analysis)."""
     return pd.DataFrame([{**values, "reason": reason}])

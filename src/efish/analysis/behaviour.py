@@ -17,10 +17,6 @@ from .inequality import theil_t, win_ratio
 from .selection import ols_fit
 from .stats import STAT_COLUMNS, stars
 
-#: Centre of the one-patch arena's patch (150 x 150 cm, docs/model/environment.md#arenas-and-food) and its radius.
-ONE_PATCH_XY_CM = (75.0, 75.0)
-ONE_PATCH_RADIUS_CM = 6.0
-
 
 def food_per_agent_episode(episodes: pd.DataFrame) -> pd.DataFrame:
     """Food eaten per agent-episode with the agent's share of its episode's food and its size rank.
@@ -207,13 +203,14 @@ def food_time_course(steps: pd.DataFrame, every: int = 1) -> pd.DataFrame:
     return or_nan_row(out.assign(reason=""), "empty steps table")
 
 
-def reach_times(steps: pd.DataFrame, patch_xy_cm: tuple[float, float] = ONE_PATCH_XY_CM,
-                reach_cm: float = ONE_PATCH_RADIUS_CM) -> pd.DataFrame:
+def reach_times(steps: pd.DataFrame, patch_xy_cm: tuple[float, float], reach_cm: float) -> pd.DataFrame:
     """First step at which each agent's centre is within ``reach_cm`` of the patch centre, per agent-episode.
 
-    Defaults: the one-patch arena's patch (centre of 150 x 150 cm, radius 6 cm,
-    docs/model/environment.md#arenas-and-food). ``reached`` is False and
-    ``t_reach`` NaN for an agent that never got there.
+    The patch is the run's (the centre of its arena and ``arena.onepatch_radius_cm``,
+    docs/model/environment.md#arenas-and-food), passed in by the caller rather
+    than defaulted here, where a second copy of the arena could disagree with
+    the run. ``reached`` is False and ``t_reach`` NaN for an agent that never
+    got there.
     """
     require(steps, [*AGENT_EPISODE, "t", "x_cm", "y_cm"], "steps table")
     d = np.hypot(steps["x_cm"].to_numpy(np.float64) - patch_xy_cm[0],
@@ -224,8 +221,8 @@ def reach_times(steps: pd.DataFrame, patch_xy_cm: tuple[float, float] = ONE_PATC
     return out
 
 
-def reach_rates(steps: pd.DataFrame, patch_xy_cm: tuple[float, float] = ONE_PATCH_XY_CM,
-                reach_cm: float = ONE_PATCH_RADIUS_CM, agent: int | None = None) -> pd.DataFrame:
+def reach_rates(steps: pd.DataFrame, patch_xy_cm: tuple[float, float], reach_cm: float,
+                agent: int | None = None) -> pd.DataFrame:
     """Fraction of episodes in which an agent reached the patch, and its median time to it, per condition and agent.
 
     ``agent`` keeps one agent only, e.g. the trained agent B of the bot assay
@@ -245,8 +242,8 @@ def reach_rates(steps: pd.DataFrame, patch_xy_cm: tuple[float, float] = ONE_PATC
     return out
 
 
-def bot_reach_rates(steps: pd.DataFrame, agent: int = 1, patch_xy_cm: tuple[float, float] = ONE_PATCH_XY_CM,
-                    reach_cm: float = ONE_PATCH_RADIUS_CM) -> pd.DataFrame:
+def bot_reach_rates(steps: pd.DataFrame, patch_xy_cm: tuple[float, float], reach_cm: float,
+                    agent: int = 1) -> pd.DataFrame:
     """Reach rate of the trained agent (``agent``, B) per bot condition (Fig 5I,J; the bot is agent 0,
     docs/methods/assays.md#assay-bot)."""
     return reach_rates(steps, patch_xy_cm, reach_cm, agent=agent)

@@ -12,7 +12,8 @@ import numpy as np
 import pandas as pd
 from scipy import stats as sps
 
-from ._tables import AGENT_EPISODE, nan_frame, or_nan_row, require, wrap
+from ..units import wrap
+from ._tables import AGENT_EPISODE, nan_frame, or_nan_row, require
 from .stats import mann_whitney
 
 #: Receptor class -> error-angle column of the steps table.

@@ -23,7 +23,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ._tables import AGENT_EPISODE, DEFAULTS, EPISODE, agent_sizes, nan_frame, pairs, require, run_ids, wrap
+from ..units import wrap
+from ._tables import AGENT_EPISODE, DEFAULTS, EPISODE, agent_sizes, nan_frame, pairs, require, run_ids
 from .stats import wilcoxon_paired
 
 LABELS = ("confronting", "chasing", "fleeing", "dispersing", "unaligned", "undefined")

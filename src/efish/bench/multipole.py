@@ -38,8 +38,8 @@ from ..config.schema import EfishConfig
 from ..physics import kernels as kn
 from ..physics.fast import prepared_inputs
 from ..physics.kernel_inputs import PlanTables
-from ..physics.plan import CM
 from ..physics.sources import L_A2, L_X, L_Y, N_LIST, list_images
+from ..units import CM
 from .scaling import ScalingCase, case_config, stepper
 from .timing import best_time
 

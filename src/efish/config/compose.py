@@ -18,6 +18,7 @@ import hashlib
 import os
 import pickle
 import re
+import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TypeVar
@@ -83,7 +84,11 @@ def _inputs_digest(tree: Path) -> str:
 
 
 def _cached(kind: str, overrides: Sequence[str], build: Callable[[], T], *extra: object) -> T:
-    """``build()``, or its earlier result for the same ``kind``, overrides, ``extra`` and config inputs."""
+    """``build()``, or its earlier result for the same ``kind``, overrides, ``extra`` and config inputs.
+
+    The warnings ``build`` raised (a deprecated key, :func:`efish.config.schema.apply_renamed_keys`) are kept
+    with the result and raised again on every hit: a cached composition warns as a fresh one does.
+    """
     folder = cache_folder()
     if folder is None:
         return build()
@@ -91,18 +96,29 @@ def _cached(kind: str, overrides: Sequence[str], build: Callable[[], T], *extra:
     key = hashlib.sha256(repr((kind, str(tree), list(overrides), extra, _inputs_digest(tree))).encode()).hexdigest()
     path = folder / f"{key}.pkl"
     try:
-        return pickle.loads(path.read_bytes())
+        value, caught = pickle.loads(path.read_bytes())
     except Exception:  # absent, half-written by a killed process, or from an incompatible build: compose again
-        pass
-    value = build()
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
-        tmp.write_bytes(pickle.dumps(value))
-        os.replace(tmp, path)  # atomic: a concurrent reader sees the whole file or none
-    except OSError:  # a read-only home is no reason to fail a composition
-        pass
+        caught = None
+    if caught is None:
+        value, caught = _recording_warnings(build)
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+            tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+            tmp.write_bytes(pickle.dumps((value, caught)))
+            os.replace(tmp, path)  # atomic: a concurrent reader sees the whole file or none
+        except OSError:  # a read-only home is no reason to fail a composition
+            pass
+    for message, category, filename, lineno in caught:
+        warnings.warn_explicit(message, category, filename, lineno)
     return value
+
+
+def _recording_warnings(build: Callable[[], T]) -> tuple[T, list[tuple[str, type[Warning], str, int]]]:
+    """``build()`` and the warnings it raised, as (message, category, filename, line), not yet shown."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        value = build()
+    return value, [(str(w.message), w.category, w.filename, w.lineno) for w in caught]
 
 
 def _register_schemas() -> None:

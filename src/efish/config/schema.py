@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -37,6 +38,54 @@ def group(cls: type) -> Any:
     return field(default_factory=cls)
 
 
+# ---------------------------------------------------------------- renamed keys
+#: Group -> {deprecated key: its new name}. A deprecated key is a field that defaults to None; setting it (in YAML,
+#: on the command line, in a recorded config) warns and sets the new key (:func:`apply_renamed_keys`). Each stays
+#: for one release after its rename (CHANGELOG.md, "Deprecated").
+RENAMED_KEYS: dict[str, dict[str, str]] = {
+    "physics": {"agent_dipole_cm": "agent_dipole_coulomb_metre", "pellet_dipole_cm": "pellet_dipole_coulomb_metre"},
+}
+
+
+def apply_renamed_keys(obj: Any, path: str, renamed: dict[str, str]) -> None:
+    """Move the value of each deprecated key of dataclass ``obj`` that is set to its new key, with a FutureWarning
+    naming the new key; the deprecated key reads None afterwards.
+
+    Setting both is a :class:`ConfigError`, recognised by the new key holding another value than its default (the
+    schema cannot tell a default from the same value written out). FutureWarning, not DeprecationWarning: the
+    keys are set by users of the command line and YAML files, and Python hides DeprecationWarning outside
+    ``__main__``.
+    """
+    defaults = {f.name: f.default for f in dataclasses.fields(obj)}
+    for old, new in renamed.items():
+        value = getattr(obj, old)
+        if value is None:
+            continue
+        if getattr(obj, new) != defaults[new]:
+            raise ConfigError(f"{path}{old} and {path}{new} are both set: {old} is the deprecated name of {new}; "
+                              f"set only {path}{new}")
+        warnings.warn(f"{path}{old} is deprecated and will be removed in the next release: set {path}{new} instead",
+                      FutureWarning, stacklevel=4)
+        setattr(obj, new, value)
+        setattr(obj, old, None)
+
+
+def with_current_key_names(config: dict) -> dict:
+    """A recorded config as a nested dict (a checkpoint's ``training_config``) with every deprecated key's value
+    under its new name, as this version records it: a checkpoint written before a rename still resumes."""
+    out = dict(config)
+    for group, renamed in RENAMED_KEYS.items():
+        if not isinstance(out.get(group), dict):
+            continue
+        values = dict(out[group])
+        for old, new in renamed.items():
+            if values.get(old) is not None and new not in values:
+                values[new] = values[old]
+            values[old] = None
+        out[group] = values
+    return out
+
+
 # --------------------------------------------------------------------- physics
 @dataclass
 class PhysicsConfig:
@@ -48,8 +97,8 @@ class PhysicsConfig:
     agent_radius_cm: float = param(1.0, "agent body radius, cm: centres stay 2 radii apart and 1 from walls; "
                                    "induction radius; the sensors sit on this circle", lo=0.0)
     pellet_radius_cm: float = param(0.25, "pellet radius (induction, ray hits), cm", lo=0.0)
-    agent_dipole_cm: float = param(1.11e-23, "agent intrinsic dipole along body +x, C*m")
-    pellet_dipole_cm: float = param(1.11e-24, "pellet intrinsic dipole along pellet +y, C*m")
+    agent_dipole_coulomb_metre: float = param(1.11e-23, "agent intrinsic dipole along body +x, C*m")
+    pellet_dipole_coulomb_metre: float = param(1.11e-24, "pellet intrinsic dipole along pellet +y, C*m")
     susceptibility: float = param(-0.5, "chi of bodies in water (negative: insulator)", lo=-10.0, hi=10.0)
     softening_m: float = param(1e-5, "eps in |d|^2 + eps^2, m", lo=0.0, hi=1e-2)
     image_order: int = param(1, "wall image order: 0 none, 1 one mirror per wall, up to 3", lo=0, hi=3)
@@ -66,6 +115,15 @@ class PhysicsConfig:
                                    "from; the first is evaluated densely over all sources; [] = off")
     far_field_min_cm: float = param(3.0, "sources closer than this are always evaluated at every sensor, cm", lo=1.0)
     far_field_safety: float = param(100.0, "C in the interpolation error model C * Q * B * (r/D)^((Q+1)/2)", lo=1.0)
+    # The old names of the two dipole moments (`_cm` read as centimetres, but they are C*m): they still work for
+    # one release, with a FutureWarning; __post_init__ moves their value to the new key.
+    agent_dipole_cm: float | None = param(None, "deprecated: the old name of agent_dipole_coulomb_metre (C*m, not "
+                                          "cm); setting it warns and sets that key")
+    pellet_dipole_cm: float | None = param(None, "deprecated: the old name of pellet_dipole_coulomb_metre (C*m, not "
+                                           "cm); setting it warns and sets that key")
+
+    def __post_init__(self) -> None:
+        apply_renamed_keys(self, "physics.", RENAMED_KEYS["physics"])
 
 
 # --------------------------------------------------------------------- sensors

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..units import wrap
+
 
 def bot_actions(xy: np.ndarray, heading: np.ndarray, w_max: np.ndarray, centre: np.ndarray, radius: float,
                 rate: float, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -20,7 +22,7 @@ def bot_actions(xy: np.ndarray, heading: np.ndarray, w_max: np.ndarray, centre: 
     d = np.linalg.norm(offset, axis=1)
     keep = keep_draw < 1.0 - d / radius if radius > 0 else np.zeros(k, bool)
     bearing = np.arctan2(offset[:, 1], offset[:, 0])
-    error = (bearing - heading + np.pi) % (2 * np.pi) - np.pi
+    error = wrap(bearing - heading)
     steer = np.clip(error / np.maximum(w_max, 1e-12), -1.0, 1.0)
     inward = np.cos(heading + steer * w_max - bearing) > 0
     return (np.where(keep, move, np.where(inward, move, 0.0)), np.where(keep, turn, steer), eod_draw < rate)

@@ -103,7 +103,7 @@ def eat_and_move(xy, heading, eat_cd, bite_cd, move, turn, bite, v_max, w_max, p
                     eaten[b, i] = best_k
                     eat_cd[b, i] = int(p[EAT_CD])
             theta = heading[b, i] + turn[b, i] * w_max[b, i]
-            theta = (theta + np.pi) % (2 * np.pi) - np.pi
+            theta = (theta + np.pi) % (2 * np.pi) - np.pi  # efish.units.wrap, inline: a numba kernel cannot call it
             heading[b, i] = theta
             step = move[b, i] * v_max[b, i]
             x = min(max(xy[b, i, 0] + step * np.cos(theta), p[WALL]), width[b] - p[WALL])

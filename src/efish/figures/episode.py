@@ -26,6 +26,7 @@ import pandas as pd
 from ..config.recorded import recorded_conditions
 from ..config.schema import EfishConfig
 from ..io import atomic_path, read_parquet
+from ..units import CM
 from .style import HEATMAP_CMAP, NEUTRAL_COLOUR, PELLET_COLOUR, agent_colour, panel_style
 
 #: GIF frame delays are whole centiseconds and browsers slow delays under 2 cs down, so a GIF plays at most
@@ -199,7 +200,7 @@ class FieldOverlay:
         self.xs = np.arange(step / 2, self.width, step)
         self.ys = np.arange(step / 2, self.height, step)
         gx, gy = np.meshgrid(self.xs, self.ys)
-        self.points_m = np.column_stack([gx.ravel(), gy.ravel()]) * 0.01
+        self.points_m = np.column_stack([gx.ravel(), gy.ravel()]) * CM
         self.vmin = math.log10(cfg.sensors.knollenorgan.threshold)
         self.vmax = math.log10(cfg.sensors.mormyromast.e_max)
 
@@ -214,7 +215,7 @@ class FieldOverlay:
             "x_cm": np.r_[ep.xy[i][here, 0], pellets["x_cm"]], "y_cm": np.r_[ep.xy[i][here, 1], pellets["y_cm"]],
             "heading_rad": np.r_[ep.heading[i][here], np.zeros(len(pellets))]})
         total, _ = scene_field(self.points_m, bodies, ep.cfg, walls=True,
-                               arena_m=(self.width * 0.01, self.height * 0.01))
+                               arena_m=(self.width * CM, self.height * CM))
         with np.errstate(divide="ignore"):
             return np.log10(np.hypot(total[:, 0], total[:, 1])).reshape(len(self.ys), len(self.xs))
 

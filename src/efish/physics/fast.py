@@ -6,10 +6,11 @@ import weakref
 
 import numpy as np
 
+from ..units import CM
 from . import kernels as kn
 from .far_field import flat_far_tables, level_tables
 from .kernel_inputs import BatchArrays, Outputs, PlanTables
-from .plan import CM, EffectPlan
+from .plan import EffectPlan
 from .readings import RawReadings, empty_readings
 from .sense_kernel import sense_batch_kernel
 from .snapshot import SnapshotBatch

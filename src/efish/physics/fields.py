@@ -4,6 +4,13 @@ These are the public, readable versions of the formulas; the numba kernels in
 :mod:`efish.physics.kernels` evaluate the same expressions source by source.
 Distances are softened, |d|^2 -> |d|^2 + eps^2, so a source on an observation
 point gives a finite field.
+
+Two shapes of the same formulas: :func:`monopole_field` and :func:`dipole_field`
+sum K sources at M points (the reference and the scenes), while
+:func:`pairwise_monopole_field` and :func:`pairwise_dipole_field` give the field
+of each source at its own point, broadcast over any leading axes and not summed
+(the rollout's measures, which pair bodies with agents across a batch). Both
+shapes share the per-source terms below, so they cannot drift apart.
 """
 
 from __future__ import annotations
@@ -22,6 +29,19 @@ def coulomb_constant(eps0: float = _DEFAULTS.eps0) -> float:
     return 1.0 / (4.0 * np.pi * eps0)
 
 
+def polarisability(radius_m: float | np.ndarray, susceptibility: float, eps0: float = _DEFAULTS.eps0
+                   ) -> float | np.ndarray:
+    """alpha = chi r^3 / k (C*m per V/m) of a body of radius ``radius_m`` (docs/model/physics.md#induction).
+
+    A body in an EOD field E carries the induced dipole p = alpha E; chi < 0
+    (an insulator in water) turns p against E.
+
+    >>> print(f"{polarisability(0.01, -0.5):.4e}")  # an agent of 1 cm radius
+    -5.5631e-17
+    """
+    return radius_m ** 3 * susceptibility / coulomb_constant(eps0)
+
+
 def _as_points(name: str, a: np.ndarray, width: int = 2) -> np.ndarray:
     a = np.asarray(a, dtype=np.float64)
     if a.ndim != 2 or a.shape[1] != width:
@@ -31,12 +51,22 @@ def _as_points(name: str, a: np.ndarray, width: int = 2) -> np.ndarray:
     return a
 
 
-def _displacements(points: np.ndarray, positions: np.ndarray, softening: float
-                   ) -> tuple[np.ndarray, np.ndarray]:
-    """d = point - source (M, K, 2) and the softened squared distance (M, K)."""
-    d = points[:, None, :] - positions[None, :, :]
-    r2 = np.einsum("mki,mki->mk", d, d) + softening * softening
-    return d, r2
+def _softened_r2(d: np.ndarray, softening: float) -> np.ndarray:
+    """|d|^2 + eps^2 over the last axis of displacements ``d`` [..., 2]."""
+    return np.einsum("...i,...i->...", d, d) + softening * softening
+
+
+def _monopole_weight(r2: np.ndarray, charges: np.ndarray) -> np.ndarray:
+    """q / |d|^3 (softened) per source: the monopole field is k times this times d."""
+    return charges * r2 ** -1.5
+
+
+def _dipole_terms(d: np.ndarray, r2: np.ndarray, moments: np.ndarray) -> np.ndarray:
+    """3 (p.d) d / |d|^5 - p / |d|^3 (softened) per source, [..., 2]: the dipole field is k times this."""
+    inv_r3 = r2 ** -1.5
+    inv_r5 = inv_r3 / r2
+    p_dot_d = np.einsum("...i,...i->...", d, moments)
+    return 3.0 * d * (p_dot_d * inv_r5)[..., None] - moments * inv_r3[..., None]
 
 
 def monopole_field(points: np.ndarray, positions: np.ndarray, charges: np.ndarray, *,
@@ -54,9 +84,9 @@ def monopole_field(points: np.ndarray, positions: np.ndarray, charges: np.ndarra
     charges = np.asarray(charges, dtype=np.float64)
     if charges.shape != (positions.shape[0],):
         raise ValueError(f"charges must have shape ({positions.shape[0]},), got {charges.shape}")
-    d, r2 = _displacements(points, positions, softening)
-    inv_r3 = r2 ** -1.5
-    return coulomb_constant(eps0) * np.einsum("mki,mk->mi", d, charges[None, :] * inv_r3)
+    d = points[:, None, :] - positions[None, :, :]                       # (M, K, 2): point - source
+    weight = _monopole_weight(_softened_r2(d, softening), charges[None, :])
+    return coulomb_constant(eps0) * np.einsum("mki,mk->mi", d, weight)
 
 
 def dipole_field(points: np.ndarray, positions: np.ndarray, moments: np.ndarray, *,
@@ -74,9 +104,43 @@ def dipole_field(points: np.ndarray, positions: np.ndarray, moments: np.ndarray,
     moments = _as_points("moments", moments)
     if moments.shape[0] != positions.shape[0]:
         raise ValueError(f"moments must have shape ({positions.shape[0]}, 2), got {moments.shape}")
-    d, r2 = _displacements(points, positions, softening)
-    inv_r3 = r2 ** -1.5
-    inv_r5 = inv_r3 / r2
-    p_dot_d = np.einsum("mki,ki->mk", d, moments)
-    e = 3.0 * d * (p_dot_d * inv_r5)[..., None] - moments[None, :, :] * inv_r3[..., None]
-    return coulomb_constant(eps0) * e.sum(axis=1)
+    d = points[:, None, :] - positions[None, :, :]                       # (M, K, 2): point - source
+    terms = _dipole_terms(d, _softened_r2(d, softening), moments[None, :, :])
+    return coulomb_constant(eps0) * terms.sum(axis=1)
+
+
+def pairwise_monopole_field(points: np.ndarray, positions: np.ndarray, charges: np.ndarray, *,
+                            softening: float = _DEFAULTS.softening_m, eps0: float = _DEFAULTS.eps0) -> np.ndarray:
+    """Field k q d / |d|^3 of each charge at its own point, not summed over sources.
+
+    points [..., 2] m, positions [..., 2] m and charges [...] C broadcast
+    against each other (numpy rules, the last axis of points and positions
+    being x, y) -> [..., 2] V/m, float64. :func:`monopole_field` is the sum of
+    this over sources.
+
+    >>> E = pairwise_monopole_field([[0.1, 0.0], [0.0, 0.2]], [0.0, 0.0], 1e-12, softening=0.0)
+    >>> print(np.round(E, 6))  # k q / r^2, away from the charge
+    [[0.898774 0.      ]
+     [0.       0.224694]]
+    """
+    d = np.asarray(points, dtype=np.float64) - np.asarray(positions, dtype=np.float64)
+    weight = _monopole_weight(_softened_r2(d, softening), np.asarray(charges, dtype=np.float64))
+    return coulomb_constant(eps0) * (d * weight[..., None])
+
+
+def pairwise_dipole_field(points: np.ndarray, positions: np.ndarray, moments: np.ndarray, *,
+                          softening: float = _DEFAULTS.softening_m, eps0: float = _DEFAULTS.eps0) -> np.ndarray:
+    """Field k (3 (p.d) d / |d|^5 - p / |d|^3) of each dipole at its own point, not summed over sources.
+
+    points, positions (m) and moments (C*m) [..., 2] broadcast against each
+    other -> [..., 2] V/m, float64. :func:`dipole_field` is the sum of this
+    over sources.
+
+    >>> E = pairwise_dipole_field([[0.1, 0.0], [0.0, 0.1]], [0.0, 0.0], [1e-12, 0.0], softening=0.0)
+    >>> print(np.round(E, 4))  # on axis p / (2 pi eps0 x^3); broadside half of it, against p
+    [[17.9755  0.    ]
+     [-8.9877  0.    ]]
+    """
+    d = np.asarray(points, dtype=np.float64) - np.asarray(positions, dtype=np.float64)
+    terms = _dipole_terms(d, _softened_r2(d, softening), np.asarray(moments, dtype=np.float64))
+    return coulomb_constant(eps0) * terms

@@ -31,12 +31,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..config.schema import EfishConfig
+from ..units import CM
 from .far_field import far_field_tables
-from .fields import coulomb_constant
+from .fields import coulomb_constant, polarisability
 from .geometry import ampullary_angles, knollenorgan_angles, mormyromast_angles
 from .images import image_indices, image_weights
-
-CM = 0.01  # m per cm
 
 
 @dataclass(frozen=True)
@@ -199,13 +198,12 @@ def build_plan(cfg: EfishConfig, scene: Scene | None = None, *, tolerance: float
     k = coulomb_constant(ph.eps0)
     order = ph.image_order if walls else 0
     idx = image_indices(order)
-    chi = ph.susceptibility
     return EffectPlan(
         effects=effects, dtype=dtype or ph.dtype, tolerance=tol,
         eps0=ph.eps0, k=k, eod_charge=ph.eod_charge_c, eod_half_separation=ph.eod_half_separation_cm * CM,
-        agent_dipole=ph.agent_dipole_cm, pellet_dipole=ph.pellet_dipole_cm,
-        alpha_agent=(ph.agent_radius_cm * CM) ** 3 * chi / k,
-        alpha_pellet=(ph.pellet_radius_cm * CM) ** 3 * chi / k,
+        agent_dipole=ph.agent_dipole_coulomb_metre, pellet_dipole=ph.pellet_dipole_coulomb_metre,
+        alpha_agent=polarisability(ph.agent_radius_cm * CM, ph.susceptibility, ph.eps0),
+        alpha_pellet=polarisability(ph.pellet_radius_cm * CM, ph.susceptibility, ph.eps0),
         softening2=ph.softening_m ** 2,
         image_indices=idx, image_weights=image_weights(idx, ph.image_scale), image_scale=ph.image_scale,
         sensor_radius=ph.agent_radius_cm * CM,  # the sensors sit on the body circle

@@ -9,18 +9,31 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..units import CM
 from .fields import dipole_field, monopole_field
 from .geometry import conspecific_slots, sensor_frame
 from .images import image_sources
-from .plan import CM, EffectPlan
+from .plan import EffectPlan
 from .readings import RawReadings, empty_readings
 from .snapshot import SnapshotBatch
 
 
 def eod_monopoles(xy: np.ndarray, heading: np.ndarray, plan: EffectPlan) -> tuple[np.ndarray, np.ndarray]:
-    """Positions (2, 2) m and charges (2,) C of one emitter's EOD: +q ahead, -q behind."""
-    u = np.array([np.cos(heading), np.sin(heading)]) * plan.eod_half_separation
-    return np.stack([xy + u, xy - u]), np.array([plan.eod_charge, -plan.eod_charge])
+    """Positions [..., 2, 2] m and charges (2,) C of the EODs of emitters at ``xy`` [..., 2] m with ``heading``
+    [...]: +q ahead, -q behind (axis -2 is the monopole). One emitter: positions (2, 2)."""
+    heading = np.asarray(heading)
+    u = np.stack([np.cos(heading), np.sin(heading)], axis=-1) * plan.eod_half_separation
+    return np.stack([xy + u, xy - u], axis=-2), np.array([plan.eod_charge, -plan.eod_charge])
+
+
+def intrinsic_moments(heading: np.ndarray, pellet_phi: np.ndarray, plan: EffectPlan) -> np.ndarray:
+    """Intrinsic dipoles (C*m) [..., N + P, 2] of N agents with ``heading`` [..., N], along body +x, then of P
+    pellets with orientation ``pellet_phi`` [..., P], along pellet +y, i.e. (-sin phi, cos phi) in world
+    coordinates (docs/model/physics.md#field-sources)."""
+    heading, pellet_phi = np.asarray(heading), np.asarray(pellet_phi)
+    return np.concatenate([plan.agent_dipole * np.stack([np.cos(heading), np.sin(heading)], axis=-1),
+                           plan.pellet_dipole * np.stack([-np.sin(pellet_phi), np.cos(pellet_phi)], axis=-1)],
+                          axis=-2)
 
 
 def _normal_component(e: np.ndarray, normals: np.ndarray) -> np.ndarray:
@@ -63,10 +76,7 @@ def _reference_env(batch: SnapshotBatch, b: int, plan: EffectPlan, out: RawReadi
             p_ind[:, e] = alpha[:, None] * e_at
             p_ind[e, e] = 0.0                                   # a body is not polarised by its own EOD
 
-    # Intrinsic dipoles (docs/model/physics.md#field-sources): agents along body +x, pellets along pellet +y.
-    p_int = np.concatenate([
-        plan.agent_dipole * np.stack([np.cos(heading), np.sin(heading)], axis=1),
-        plan.pellet_dipole * np.stack([-np.sin(phi), np.cos(phi)], axis=1)])
+    p_int = intrinsic_moments(heading, phi, plan)
 
     def dipoles_at(points, normals, positions, moments, skip_identity=False):
         ipos, imom, _ = image_sources(positions, moments, w, h, idx, scale)

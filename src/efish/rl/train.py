@@ -26,7 +26,13 @@ import numpy as np
 import pandas as pd
 import torch
 
-from ..config.schema import EfishConfig, config_differences, result_neutral_keys, training_config
+from ..config.schema import (
+    EfishConfig,
+    config_differences,
+    result_neutral_keys,
+    training_config,
+    with_current_key_names,
+)
 from ..env.vec_env import VecEnv
 from ..io import atomic_path, remove_partial_writes
 from ..layout import stage_file
@@ -393,8 +399,9 @@ def _with_precision(config: dict, precision: str) -> dict:
 
 
 def _config_differences(state: dict, cfg: EfishConfig, compute: Compute) -> list[str]:
-    """The result-relevant keys in which a checkpoint's (or stage's) run differs from this one."""
-    recorded = _with_precision(state["config"], recorded_precision(state))
+    """The result-relevant keys in which a checkpoint's (or stage's) run differs from this one; a checkpoint written
+    under a key's deprecated name is read under its new name."""
+    recorded = _with_precision(with_current_key_names(state["config"]), recorded_precision(state))
     return config_differences(recorded, _with_precision(training_config(cfg), compute.precision),
                               result_neutral_keys())
 

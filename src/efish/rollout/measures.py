@@ -10,24 +10,25 @@ the analyses must not recompute (error angles of a homer against its target's
 local fields; log10 of the Mormyromast- and Ampullary-relevant fields at the
 body centre). Every function returns arrays [B, N] keyed by their column names
 (or one such array).
+
+The fields are the physics' own: the formulas of :mod:`efish.physics.fields`, the
+EOD monopoles and intrinsic moments of :mod:`efish.physics.reference`, and the
+constants (charges, moments, polarisabilities) of the env's effect plan, so a
+recorded field cannot drift from the simulated one.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..config.schema import EfishConfig
 from ..env.geometry import nearest_pellet
 from ..env.vec_env import VecEnv
-from ..physics.fields import coulomb_constant
+from ..physics.fields import pairwise_dipole_field, pairwise_monopole_field
+from ..physics.plan import EffectPlan
+from ..physics.reference import eod_monopoles, intrinsic_moments
+from ..units import CM, wrap
 
-CM = 0.01  # m per cm
 SECTORS = ("front", "left", "back", "right")  # bearing within pi/4 of 0, pi/2, pi, -pi/2
-
-
-def wrap(a: np.ndarray) -> np.ndarray:
-    """Angles wrapped to [-pi, pi)."""
-    return (a + np.pi) % (2 * np.pi) - np.pi
 
 
 def nearest(env: VecEnv) -> dict[str, np.ndarray]:
@@ -123,29 +124,17 @@ def log_morm_sensed(morm_block: np.ndarray, e_min: float, e_max: float) -> np.nd
     return np.where(y > 0, lo + y * (hi - lo), np.nan)
 
 
-def eod_field(xy_m: np.ndarray, heading: np.ndarray, at_m: np.ndarray, cfg: EfishConfig) -> np.ndarray:
-    """Direct EOD field (V/m) of emitters at ``xy_m`` [..., 2] with ``heading`` [...] at points ``at_m`` [..., 2]."""
-    ph = cfg.physics
-    k, q, half = coulomb_constant(ph.eps0), ph.eod_charge_c, ph.eod_half_separation_cm * CM
-    u = np.stack([np.cos(heading), np.sin(heading)], -1) * half
-    e = np.zeros(np.broadcast_shapes(xy_m.shape, at_m.shape))
-    for sign in (1.0, -1.0):
-        d = at_m - (xy_m + sign * u)
-        r2 = (d * d).sum(-1) + ph.softening_m ** 2
-        e += sign * k * q * d / r2[..., None] ** 1.5
-    return e
-
-
-def dipole_at(p: np.ndarray, source_m: np.ndarray, at_m: np.ndarray, cfg: EfishConfig) -> np.ndarray:
-    """Field (V/m) of dipoles ``p`` [..., 2] at ``source_m`` [..., 2] at points ``at_m`` [..., 2]."""
-    k = coulomb_constant(cfg.physics.eps0)
-    d = at_m - source_m
-    r2 = (d * d).sum(-1) + cfg.physics.softening_m ** 2
-    p_dot_d = (p * d).sum(-1)
-    return k * (3.0 * d * (p_dot_d / r2 ** 2.5)[..., None] - p / r2[..., None] ** 1.5)
+def eod_field(plan: EffectPlan, softening_m: float, xy_m: np.ndarray, heading: np.ndarray,
+              at_m: np.ndarray) -> np.ndarray:
+    """Direct EOD field (V/m) of emitters at ``xy_m`` [..., 2] with ``heading`` [...] at points ``at_m`` [..., 2]
+    (broadcast): the physics' two EOD monopoles of each emitter (efish.physics.reference.eod_monopoles), summed."""
+    positions, charges = eod_monopoles(xy_m, heading, plan)            # [..., 2 monopoles, 2], (2,)
+    e = pairwise_monopole_field(at_m[..., None, :], positions, charges, softening=softening_m, eps0=plan.eps0)
+    return e.sum(axis=-2)
 
 
 def angle_of(e: np.ndarray) -> np.ndarray:
+    """Direction (rad) of vectors ``e`` [..., 2]."""
     return np.arctan2(e[..., 1], e[..., 0])
 
 
@@ -159,7 +148,7 @@ def homing_errors(env: VecEnv) -> dict[str, np.ndarray]:
     space (no wall images), at the homer's centre. NaN for the target itself and
     in tasks without a target.
     """
-    s, cfg = env.state, env.cfg
+    s, plan, soft = env.state, env.plan, env.cfg.physics.softening_m
     shape = s.heading.shape
     target = getattr(env.task, "target", None)
     if target is None or not target.any():
@@ -167,13 +156,12 @@ def homing_errors(env: VecEnv) -> dict[str, np.ndarray]:
     t = int(np.flatnonzero(target)[0])
     xy, h = s.xy * CM, s.heading
     txy, th = xy[:, t:t + 1], h[:, t:t + 1]                           # [B, 1, 2], [B, 1]
-    ph = cfg.physics
-    e_knollen = eod_field(txy, th, xy, cfg)
-    p_intrinsic = ph.agent_dipole_cm * np.stack([np.cos(th), np.sin(th)], -1)
-    e_amp = dipole_at(p_intrinsic, txy, xy, cfg)
-    alpha = (ph.agent_radius_cm * CM) ** 3 * ph.susceptibility / coulomb_constant(ph.eps0)
-    p_induced = alpha * eod_field(xy, h, np.broadcast_to(txy, xy.shape), cfg)   # each homer's EOD at the target
-    e_morm = dipole_at(p_induced, txy, xy, cfg)
+    field = {"softening": soft, "eps0": plan.eps0}
+    e_knollen = eod_field(plan, soft, txy, th, xy)
+    p_intrinsic = intrinsic_moments(th, np.empty((len(th), 0)), plan)  # the target's own dipole [B, 1, 2]; no pellets
+    e_amp = pairwise_dipole_field(xy, txy, p_intrinsic, **field)
+    p_induced = plan.alpha_agent * eod_field(plan, soft, xy, h, txy)   # each homer's EOD at the target
+    e_morm = pairwise_dipole_field(xy, txy, p_induced, **field)
     out = {}
     for name, e in (("morm", e_morm), ("amp", e_amp), ("knollen", e_knollen)):
         err = wrap(h - angle_of(e))
@@ -189,21 +177,20 @@ def log_fields(env: VecEnv) -> dict[str, np.ndarray]:
     dipoles the agent's own EOD induces on every other body. Free space, live
     pellets only; -inf where the field is exactly 0.
     """
-    s, ph = env.state, env.cfg.physics
+    s, plan, soft = env.state, env.plan, env.cfg.physics.softening_m
     xy, h = s.xy * CM, s.heading
     bodies = np.concatenate([xy, s.pellet_xy * CM], axis=1)             # [B, N + P, 2]
     n = env.n
     live = np.concatenate([np.ones(xy.shape[:2], bool), s.alive], axis=1)
-    p_int = np.concatenate([ph.agent_dipole_cm * np.stack([np.cos(h), np.sin(h)], -1),
-                            ph.pellet_dipole_cm * np.stack([-np.sin(s.pellet_phi), np.cos(s.pellet_phi)], -1)], 1)
-    radius = np.concatenate([np.full(xy.shape[:2], ph.agent_radius_cm), np.full(s.alive.shape, ph.pellet_radius_cm)],
-                            axis=1) * CM
-    alpha = radius ** 3 * ph.susceptibility / coulomb_constant(ph.eps0)   # [B, N + P]
-    centre = xy[:, :, None, :]                                            # [B, N, 1, 2]
+    is_agent = np.arange(bodies.shape[1]) < n
+    alpha = np.where(is_agent, plan.alpha_agent, plan.alpha_pellet)     # [N + P]
+    centre = xy[:, :, None, :]                                          # [B, N, 1, 2]
     others = live[:, None, :] & ~np.eye(n, bodies.shape[1], dtype=bool)[None]
-    e_amp = dipole_at(p_int[:, None], bodies[:, None], centre, env.cfg)                  # [B, N, N + P, 2]
-    e_eod = eod_field(xy[:, :, None, :], h[:, :, None], bodies[:, None], env.cfg)        # own EOD at every body
-    e_morm = dipole_at(alpha[:, None, :, None] * e_eod, bodies[:, None], centre, env.cfg)
+    p_int = intrinsic_moments(h, s.pellet_phi, plan)                    # [B, N + P, 2]
+    field = {"softening": soft, "eps0": plan.eps0}
+    e_amp = pairwise_dipole_field(centre, bodies[:, None], p_int[:, None], **field)    # [B, N, N + P, 2]
+    e_eod = eod_field(plan, soft, xy[:, :, None, :], h[:, :, None], bodies[:, None])   # own EOD at every body
+    e_morm = pairwise_dipole_field(centre, bodies[:, None], alpha[:, None] * e_eod, **field)
     with np.errstate(divide="ignore"):
         return {name: np.log10(np.linalg.norm((e * others[..., None]).sum(2), axis=-1))
                 for name, e in (("log_amp_field", e_amp), ("log_morm_field", e_morm))}

@@ -8,6 +8,7 @@ import pandas as pd
 from ..config.schema import EfishConfig
 from ..env.observe import observation_slices
 from ..env.vec_env import VecEnv
+from ..units import wrap
 from .measures import (
     agents_in_range,
     food_counts,
@@ -16,7 +17,6 @@ from .measures import (
     log_fields,
     log_morm_sensed,
     nearest,
-    wrap,
 )
 
 

@@ -34,10 +34,11 @@ from ..env.arenas import sample_arena, sample_pellets
 from ..physics.fields import dipole_field, monopole_field
 from ..physics.geometry import ampullary_angles, knollenorgan_angles, mormyromast_angles, sensor_frame
 from ..physics.images import image_sources
-from ..physics.plan import CM, EffectPlan, Scene, build_plan
+from ..physics.plan import EffectPlan, Scene, build_plan
 from ..physics.reference import eod_monopoles
 from ..physics.snapshot import Snapshot, SnapshotBatch
 from ..sensors.sense import raw_readings
+from ..units import CM
 
 F64, B, S = pa.float64(), pa.bool_(), pa.string()
 RECEPTORS = ("mormyromast", "ampullary", "knollenorgan")
