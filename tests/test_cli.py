@@ -41,7 +41,9 @@ def seed_run(tmp_path, monkeypatch):
 
     def fixed(results, cfg):
         table = claims_rows({"C1": "holds", "C9": "holds"})
-        parts = table.rename(columns={"panel": "part"}).assign(sign=1.0, decides=True)[PART_COLUMNS]
+        parts = table.rename(columns={"panel": "part"}).assign(sign=1.0, decides=True, ci_method="",
+                                                               margin=float("nan"), margin_ratio=float("nan"))
+        parts = parts[PART_COLUMNS]
         return table, parts
 
     monkeypatch.setattr(claims, "claims_and_parts", fixed)

@@ -52,11 +52,26 @@ def test_tost_shows_equivalence_of_equal_samples_more_easily_as_n_grows():
 
 
 def test_equivalence_margin_is_relative_unless_the_control_sits_near_zero():
-    assert equivalence_margin(np.full(10, 20.0), 2.0, 0.2, 0.5) == (pytest.approx(4.0), "0.2 x control median 20")
-    margin, how = equivalence_margin(np.array([0.0, 0.1, -0.1]), 1.0, 0.2, 0.5)
-    assert margin == 0.5 and "pooled SD" in how
+    assert equivalence_margin(np.full(10, 20.0), 2.0, 0.2, 0.5) == (pytest.approx(4.0), pytest.approx(0.2),
+                                                                   "0.2 x control median 20")
+    # a median of 0 (mostly-zero counts): 0.5 SD of the differences, within half the typical value (mean 1.2)
+    margin, ratio, how = equivalence_margin(np.array([0.0, 0, 0, 2, 4]), 1.0, 0.2, 0.5)
+    assert margin == pytest.approx(0.5) and ratio == pytest.approx(0.5 / 1.2) and "SD" in how
     with pytest.raises(ValueError):
         equivalence_margin(np.zeros(4), 0.0, 0.2, 0.5)
+
+
+def test_no_margin_is_wider_than_half_the_controls_typical_value():
+    """The second audit: at seed 4, C14's margin +-12.8 was 107% of the control median 12."""
+    control = np.array([10.0, 12, 12, 14, 40])  # median 12, a wide spread (pooled SD ~13)
+    margin, ratio, how = equivalence_margin(control, 25.6, 0.2, 0.5)
+    # the median 12 is within one SD of 0, so the SD fallback applies: 0.5 x 25.6 = 12.8, capped at 6
+    assert margin == pytest.approx(6.0) and ratio == pytest.approx(0.5) and "typical value" in how
+    margin, ratio, how = equivalence_margin(np.array([0.0, 0, 0, 2, 4]), 25.6, 0.2, 0.5)  # median 0, mean 1.2
+    assert margin == pytest.approx(0.6) and ratio == pytest.approx(0.5) and "typical value" in how
+    for sd in (0.1, 1.0, 10.0, 100.0):
+        m, r, _ = equivalence_margin(np.array([3.0, 5, 8, 9]), sd, 0.2, 0.5)
+        assert 0 < r <= 0.5 and m <= 0.5 * 6.5
 
 
 def test_excess_theil_is_zero_on_average_for_equal_shares_at_any_total():

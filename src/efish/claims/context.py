@@ -13,6 +13,7 @@ A table the run lacks (:class:`MissingTable`) or data a test cannot use
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 
@@ -22,7 +23,7 @@ import pandas as pd
 from ..config.schema import EfishConfig
 from ..layout import parse_table
 from .statistics import bootstrap_ci
-from .verdicts import Outcome, Part, combine, judge
+from .verdicts import MIN_UNITS, Outcome, Part, combine, judge
 
 #: A claim's input: table path under ``results/{run}/`` -> the table.
 Tables = Mapping[str, pd.DataFrame]
@@ -42,7 +43,10 @@ def evaluate(label: str, statistic: str, compute: Callable[[], Outcome], alpha: 
     """Run one part: a missing table or degenerate data (ValueError) is a ``not run`` part whose reason says why.
 
     The part's ``p`` is the one its verdict rests on: the TOST p for a "no
-    difference" part (sign 0), else the difference test's.
+    difference" part (sign 0), else the difference test's. Fewer than
+    :data:`~efish.claims.verdicts.MIN_UNITS` units is ``not run``; a test that
+    cannot reach p < alpha at its n (``Outcome.p_floor``) is ``not decidable``
+    and says so, rather than weaker.
     """
     try:
         out = compute()
@@ -52,13 +56,21 @@ def evaluate(label: str, statistic: str, compute: Callable[[], Outcome], alpha: 
         return Part(label, statistic, reason=f"a table lacks the column or key {exc}", decides=decides)
     p = out.p_equiv if out.sign == 0 and out.verdict is None else out.p
     base = Part(label, statistic, float(out.effect), tuple(map(float, out.ci)), int(out.n), float(p), decides=decides,
-                sign=out.sign)
+                sign=out.sign, ci_method=out.ci_method, margin=float(out.margin), margin_ratio=float(out.margin_ratio))
+
+    def judged(verdict: str, *why: str) -> Part:
+        return dataclasses.replace(base, verdict=verdict, reason="; ".join(r for r in why if r))
     if out.verdict is not None:
-        return Part(**{**base.__dict__, "verdict": out.verdict, "reason": out.reason})
+        return judged(out.verdict, out.reason)
+    if out.n < MIN_UNITS:
+        return judged("not run", f"n = {out.n}: a test needs at least {MIN_UNITS} units", out.reason)
     if not (np.isfinite(out.effect) and np.isfinite(p)):
-        return Part(**{**base.__dict__, "verdict": "not run", "reason": out.reason or "no test result"})
+        return judged("not run", out.reason or "no test result")
+    if out.p_floor >= alpha:
+        return judged("not decidable", f"cannot reach significance at n = {out.n} (the smallest p its test can give "
+                                       f"is {out.p_floor:.3g})", out.reason)
     verdict, why = judge(out.effect, out.p, out.sign, alpha, out.p_equiv, out.margin)
-    return Part(**{**base.__dict__, "verdict": verdict, "reason": "; ".join(r for r in (why, out.reason) if r)})
+    return judged(verdict, why, out.reason)
 
 
 @dataclass

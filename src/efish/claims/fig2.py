@@ -42,7 +42,7 @@ def c1(ctx: Context) -> list[Part]:
         if (shape := _successful(shape)).empty:
             raise ValueError("no successful homing episode with a tortuosity")
         return mann_whitney_part(ctx, shape, "tortuosity", "condition", HOMING_ELECTRIC, HOMING_RAYCAST, +1)
-    return [ctx.part("tortuosity", "median tortuosity (path / displacement) of successful homing episodes, "
+    return [ctx.part("tortuosity", "Hodges-Lehmann shift of the tortuosity (path / displacement) of successful homing episodes, "
                      "electric minus raycast; Mann-Whitney", compute)]
 
 
@@ -80,7 +80,7 @@ def c2(ctx: Context) -> list[Part]:
         note = (f"median aligned fraction {per['observed'].median():.3f} vs {per['straight'].median():.3f} for a "
                 f"straight homer on the same positions, over {len(per)} successful episodes")
         return dataclasses.replace(out, reason="; ".join(r for r in (out.reason, note) if r))
-    return [ctx.part("aligned beyond straight homing", f"median over successful episodes of the fraction of steps "
+    return [ctx.part("aligned beyond straight homing", f"Hodges-Lehmann estimate over successful episodes of the fraction of steps "
                      f"with |cos(err_knollen)| > cos({a:.3g}) minus that of a homer heading straight at the target "
                      "from the same positions; Wilcoxon vs 0", compute)]
 
@@ -96,5 +96,5 @@ def c3(ctx: Context) -> list[Part]:
         rho = spearman(err, "t_norm", "abs_sin", by="unit")
         rho = rho.assign(episode=rho["group"] // 1000)[np.isfinite(rho["effect"])]
         return one_sample_part(ctx, rho, "effect", 0.0, -1)
-    return [ctx.part("alignment", "median over successful episodes of Spearman rho(|sin err_knollen|, normalised "
+    return [ctx.part("alignment", "Hodges-Lehmann estimate over successful episodes of Spearman rho(|sin err_knollen|, normalised "
                      "time); Wilcoxon vs 0", compute)]

@@ -118,7 +118,7 @@ def c6(ctx: Context) -> list[Part]:
         parts = diff["condition"].str.rsplit("|", n=2)
         diff["condition"], diff["episode"] = parts.str[0], parts.str[1]
         return one_sample_part(ctx, diff, "diff", 0.0, +1)
-    stat = (f"median over agent-episodes of the mean EOD rate at lags [{e0}, {e1}] minus [{b0}, {b1}] steps of "
+    stat = (f"Hodges-Lehmann estimate over agent-episodes of the mean EOD rate at lags [{e0}, {e1}] minus [{b0}, {b1}] steps of "
             "the event (wide2); Wilcoxon vs 0")
     return [ctx.part(event, stat, functools.partial(compute, event)) for event in EVENTS]
 

@@ -15,13 +15,12 @@ from __future__ import annotations
 import functools
 import re
 
-import numpy as np
 import pandas as pd
 
 from ..layout import analysis_table, assay_table
 from .context import Context, claim
 from .parts import ceiling, mann_whitney_part, margin_for, paired_part, present, spearman_part
-from .statistics import excess_theil_per_episode, mean_diff, welch_tost
+from .statistics import excess_theil_per_episode, pooled_sd, welch_tost
 from .verdicts import Outcome, Part
 
 # ablation conditions are named by the receptor classes left on (config/assay/ablation4.yaml)
@@ -35,28 +34,33 @@ def summary(ctx: Context, assay: str) -> pd.DataFrame:
 
 
 def _vs_control(ctx: Context, assay: str, condition: str, control: str, measure: str, sign: int,
-                family: list[str] | None = None) -> Outcome:
-    """A paired part of ``assay``; a food part is not decidable when the control is at a ceiling, a bites part
-    when neither condition bit at all (a floor)."""
+                family: list[str]) -> Outcome:
+    """A paired part of ``assay`` (:func:`~efish.claims.parts.paired_part`, Holm over ``family``); a food part is
+    not decidable when the control is at a ceiling."""
     s = summary(ctx, assay)
-    if family is not None:
-        s = s[s["condition"].isin([*family, control])]
+    s = s[s["condition"].isin([*family, control])]
     if measure == FOOD:
         if (at := ceiling(ctx, s, ctx.table(assay_table(assay, "food")), [control])) is not None:
             return at
-    if measure == "bites" and s.loc[s["condition"].isin([condition, control]), "bites"].sum() == 0:
-        return Outcome(np.nan, np.nan, 0, None, verdict="not decidable",
-                       reason=f"at a floor: no bite at all in {condition} or {control}")
     return paired_part(ctx, s, measure, condition, control, sign, family)
 
 
-def _parts(ctx: Context, assay: str, control: str, specs, decides: bool = True,
-           family: list[str] | None = None) -> list[Part]:
-    """One paired part per (label, condition, measure, sign) of ``specs``."""
-    stat = "median paired difference of the episode {m}, {c} minus {ctl}; Wilcoxon signed-rank, Holm"
-    return [ctx.part(label, stat.format(m=measure, c=cond, ctl=control),
-                     functools.partial(_vs_control, ctx, assay, cond, control, measure, sign, family), decides)
-            for label, cond, measure, sign in specs]
+#: A paired part: its label, assay, condition, measure and the paper's sign.
+Spec = tuple[str, str, str, str, int]
+
+
+def _parts(ctx: Context, control: str, specs: list[Spec], decides: bool = True) -> list[Part]:
+    """One paired part per spec against ``control``. Holm runs over the comparisons the parts test: one family per
+    (assay, measure), the conditions these specs compare with the control on that measure."""
+    families: dict[tuple[str, str], list[str]] = {}
+    for _, assay, cond, measure, _ in specs:
+        families.setdefault((assay, measure), []).append(cond)
+    stat = ("Hodges-Lehmann estimate of the paired differences of the episode {m}, {c} minus {ctl} ({a}); Wilcoxon "
+            "signed-rank, Holm over {k}")
+    return [ctx.part(label, stat.format(m=measure, c=cond, ctl=control, a=assay, k=len(families[assay, measure])),
+                     functools.partial(_vs_control, ctx, assay, cond, control, measure, sign,
+                                       families[assay, measure]), decides)
+            for label, assay, cond, measure, sign in specs]
 
 
 def _tables(assays, tables=("episode_summary",)) -> list[str]:
@@ -67,60 +71,56 @@ def _tables(assays, tables=("episode_summary",)) -> list[str]:
 @claim("C10", "4A-F", "short-range ablations cut food; Knollenorgan ablation keeps food, raises EOD probability "
        "and biting, lowers spacing", _tables(("ablation4", "ablation1")))
 def c10(ctx: Context) -> list[Part]:
-    return (_parts(ctx, "ablation4", ALL_ON, [("group food, M off", M_OFF, FOOD, -1),
-                                              ("group food, A off", A_OFF, FOOD, -1)])
-            + _parts(ctx, "ablation1", ALL_ON, [("solo food, M off", M_OFF, FOOD, -1),
-                                                ("solo food, A off", A_OFF, FOOD, -1)])
-            + _parts(ctx, "ablation4", ALL_ON, [
-                ("group food, K off (equivalent)", K_OFF, FOOD, 0),
-                ("EOD probability, K off", K_OFF, "eod_probability", +1), ("bites, K off", K_OFF, "bites", +1),
-                ("nearest-neighbour distance, K off", K_OFF, "mean_nn_dist_cm", -1)]))
-
-
-# config/assay/collective.yaml: the clean gates, and the authors' self-only mode (own wall images kept)
-GATES = ["self_only", "cons_only"]
+    return _parts(ctx, ALL_ON, [
+        ("group food, M off", "ablation4", M_OFF, FOOD, -1), ("group food, A off", "ablation4", A_OFF, FOOD, -1),
+        ("solo food, M off", "ablation1", M_OFF, FOOD, -1), ("solo food, A off", "ablation1", A_OFF, FOOD, -1),
+        ("group food, K off (equivalent)", "ablation4", K_OFF, FOOD, 0),
+        ("EOD probability, K off", "ablation4", K_OFF, "eod_probability", +1),
+        ("bites, K off", "ablation4", K_OFF, "bites", +1),
+        ("nearest-neighbour distance, K off", "ablation4", K_OFF, "mean_nn_dist_cm", -1)])
 
 
 @claim("C11", "4G,H", "self-only gating cuts food, cons-only does not; EOD lower in self-only, higher in cons-only",
        _tables(("collective",)))
 def c11(ctx: Context) -> list[Part]:
+    # the clean gates decide; the authors' self-only mode (own wall images kept) is beside them, its own family
+    gates = [("food, self-only", "self_only", FOOD, -1), ("food, cons-only (equivalent)", "cons_only", FOOD, 0),
+             ("EOD probability, self-only", "self_only", "eod_probability", -1),
+             ("EOD probability, cons-only", "cons_only", "eod_probability", +1)]
     authors = [("food, self-only (authors' mode)", "self_only_authors", FOOD, -1),
                ("EOD probability, self-only (authors' mode)", "self_only_authors", "eod_probability", -1)]
-    return (_parts(ctx, "collective", "control", [
-        ("food, self-only", "self_only", FOOD, -1), ("food, cons-only (equivalent)", "cons_only", FOOD, 0),
-        ("EOD probability, self-only", "self_only", "eod_probability", -1),
-        ("EOD probability, cons-only", "cons_only", "eod_probability", +1)], family=GATES)
-        + _parts(ctx, "collective", "control", authors, decides=False, family=["self_only_authors"]))
+    return (_parts(ctx, "control", [(label, "collective", c, m, s) for label, c, m, s in gates])
+            + _parts(ctx, "control", [(label, "collective", c, m, s) for label, c, m, s in authors], decides=False))
 
 
 @claim("C12", "4I,J", "muting one agent cuts group food and raises spacing", _tables(("mute",)))
 def c12(ctx: Context) -> list[Part]:
     # config/assay/mute.yaml: the Results' design (2 agents, uniform) decides; the Methods' (4, patchy) is beside it
     specs = [("group food", FOOD, -1), ("spacing", "mean_nn_dist_cm", +1)]
-    return (_parts(ctx, "mute", "intact", [(f"{label}, 2 agents", "muted", m, s) for label, m, s in specs],
-                   family=["muted"])
-            + _parts(ctx, "mute", "intact4", [(f"{label}, 4 agents (Methods)", "muted4", m, s) for label, m, s in specs],
-                     decides=False, family=["muted4"]))
+    return (_parts(ctx, "intact", [(f"{label}, 2 agents", "mute", "muted", m, s) for label, m, s in specs])
+            + _parts(ctx, "intact4", [(f"{label}, 4 agents (Methods)", "mute", "muted4", m, s)
+                                      for label, m, s in specs], decides=False))
 
 
 NPATCH = re.compile(r"(iso|free)_(\d+)$")  # config/assay/npatch.yaml
 
 
 def _episode_theil(ctx: Context, assay: str) -> pd.DataFrame:
-    """Excess Theil T of every episode of ``assay`` (totals differ), with its summary columns."""
+    """Excess Theil T and per-fish food of every episode of ``assay`` (totals differ), with its summary columns."""
     per_agent = ctx.table(analysis_table("behaviour", assay, "food_per_agent"))
-    return summary(ctx, assay).merge(excess_theil_per_episode(per_agent), on=["condition", "episode"])
+    s = summary(ctx, assay).merge(excess_theil_per_episode(per_agent), on=["condition", "episode"])
+    agents = per_agent.groupby(["condition", "episode"])["food_eaten"].size().rename("agents").reset_index()
+    s = s.merge(agents, on=["condition", "episode"])
+    return s.assign(food_per_fish=s[FOOD] / s["agents"]).drop(columns="agents")
 
 
 def _npatch(ctx: Context) -> pd.DataFrame:
-    """The N-patch sweep's episodes with ``series`` (iso, free), ``n`` and ``food_ratio``: iso food over the mean
-    food of the free series at the same n (the authors' ratio per n)."""
+    """The N-patch sweep's episodes with ``series`` (iso: fixed total food; free: food grows with n) and ``n``."""
     s = _episode_theil(ctx, "npatch")
     m = s["condition"].astype(str).str.extract(NPATCH)
     s = s.assign(series=m[0], n=pd.to_numeric(m[1]))
-    free = s[s["series"] == "free"].groupby("n")[FOOD].mean()
     present(s, "series", ["iso", "free"], "N-patch episodes")
-    return s.assign(food_ratio=s[FOOD] / s["n"].map(free).where(lambda v: v > 0))
+    return s
 
 
 @claim("C13", "4K-N", "patchy food yields more than uniform, Theil n.s.; more patches at fixed total food lower "
@@ -137,19 +137,23 @@ def c13(ctx: Context) -> list[Part]:
     def theil() -> Outcome:
         d = layouts().dropna(subset=["excess_theil"])
         x, c = (d.loc[d["condition"] == g, "excess_theil"].to_numpy() for g in ("patchy4", "uniform4"))
-        margin, how = margin_for(ctx, c, x)
-        diff, p, p_equiv = welch_tost(x, c, margin)
-        ci = ctx.ci(d, mean_diff("excess_theil", "condition", "patchy4", "uniform4"))
-        return Outcome(diff, p, len(d), 0, ci, f"margin {margin:.3g} = {how}", p_equiv=p_equiv, margin=margin)
+        margin = margin_for(ctx, c, pooled_sd(x, c))
+        diff, p, p_equiv, ci = welch_tost(x, c, margin[0], ctx.cfg.analysis.claims_alpha)
+        m, ratio, how = margin
+        return Outcome(diff, p, len(d), 0, ci, f"margin +-{m:.3g} = {how} ({ratio:.0%} of the control's typical "
+                       "value)", p_equiv=p_equiv, margin=m, margin_ratio=ratio, ci_method="inverts Welch's t-test")
 
     def sweep(series: str, value: str) -> Outcome:
         return spearman_part(ctx, _npatch(ctx).query("series == @series"), "n", value, -1)
     rho = "Spearman rho of the {} episodes' {} against the patch count n"
-    return [ctx.part("food, patchy vs uniform", "median episode food patchy4 minus uniform4; Mann-Whitney", food),
+    return [ctx.part("food, patchy vs uniform", "Hodges-Lehmann shift of the episode food, patchy4 minus uniform4; "
+                     "Mann-Whitney", food),
             ctx.part("excess Theil, patchy vs uniform (equivalent)", "mean episode Theil T above its equal-share "
                      "null at the episode's total, patchy4 minus uniform4; Welch t-test and TOST", theil),
-            ctx.part("iso/free food vs n", rho.format("iso", "food over the free series' mean food at n"),
-                     functools.partial(sweep, "iso", "food_ratio")),
+            ctx.part("iso per-fish food vs n", rho.format("iso (fixed total food)", "food per fish"),
+                     functools.partial(sweep, "iso", "food_per_fish")),
+            ctx.part("free per-fish food vs n", rho.format("free", "food per fish"),
+                     functools.partial(sweep, "free", "food_per_fish"), decides=False),
             ctx.part("iso excess Theil vs n", rho.format("iso", "excess Theil T"),
                      functools.partial(sweep, "iso", "excess_theil")),
             ctx.part("free excess Theil vs n", rho.format("free", "excess Theil T"),

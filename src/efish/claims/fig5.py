@@ -56,6 +56,11 @@ def c14(ctx: Context) -> list[Part]:
             raise ValueError(f"no B alone condition at B's size in {social}")
         b = people()
         b = b[(b["role"] == "B") & b["condition"].isin([social, matched["B", social]])]
+        alone = b.loc[b["setting"] == "alone", "food_eaten"].dropna()
+        if len(alone) and not alone.any():  # a floor (rule 5): "more with A" is all B alone could show
+            return Outcome(np.nan, np.nan, len(b), +1, verdict="not decidable",
+                           reason=f"at a floor: B alone ({matched['B', social]}) ate nothing in any of its "
+                                  f"{len(alone)} episodes, so only more food with A could appear")
         return mann_whitney_part(ctx, b, "food_eaten", "setting", social, "alone", +1)
 
     def a_unaffected() -> Outcome:
@@ -69,10 +74,10 @@ def c14(ctx: Context) -> list[Part]:
     def b_size() -> Outcome:
         b = people().query("role == 'B' and setting != 'alone'")
         return spearman_part(ctx, b, "size", "food_eaten", +1)
-    stat = "median food of B with A ({}) minus B alone at B's size; Mann-Whitney"
+    stat = "Hodges-Lehmann shift of the food of B with A ({}) against B alone at B's size; Mann-Whitney"
     return ([ctx.part(f"B social, {c}", stat.format(c), functools.partial(b_social, c))
              for c in social_conditions(configs)]
-            + [ctx.part("A social vs alone (equivalent)", "median food of A with B minus A alone at A's sizes "
+            + [ctx.part("A social vs alone (equivalent)", "Hodges-Lehmann shift of the food of A with B against A alone at A's sizes "
                         "(size classes pooled, one alone condition per class); Mann-Whitney and TOST", a_unaffected),
                ctx.part("B food vs B size", "Spearman rho of B's food against B's size over the social conditions",
                         b_size)])
@@ -135,7 +140,7 @@ def c16(ctx: Context) -> list[Part]:
         return one_sample_part(ctx, bites.dropna(subset=["phase"]), "phase", 0.5, -1)
     return [ctx.part("chaser larger", "median chaser minus chased size over chasing bouts (square2); Wilcoxon",
                      functools.partial(size_roles, ctx, "square2", "chase", "chase_sizes")),
-            ctx.part("bites early", "median normalised bite time in its bout minus 0.5; Wilcoxon", timing),
-            ctx.part("confronting bites most", "median over episodes of the bite rate per pair-step within range, "
+            ctx.part("bites early", "Hodges-Lehmann estimate of the normalised bite time in its bout minus 0.5; Wilcoxon", timing),
+            ctx.part("confronting bites most", "Hodges-Lehmann estimate over episodes of the bite rate per pair-step within range, "
                      "confronting minus the next-highest class; Wilcoxon signed-rank", functools.partial(_confronting,
                                                                                                        ctx))]

@@ -65,7 +65,7 @@ def c17(ctx: Context) -> list[Part]:
             except ValueError:
                 return np.nan
         return Outcome(b, p, n, +1, ctx.ci(d, stat))
-    return [ctx.part("low-dimensional", f"median D_eff / width ({width}) minus {a.claims_deff_fraction} (patchy4); "
+    return [ctx.part("low-dimensional", f"Hodges-Lehmann estimate of D_eff / width ({width}) minus {a.claims_deff_fraction} (patchy4); "
                      "Wilcoxon", low),
             ctx.part("D_eff grows with N, K on", "Spearman rho(mean D_eff of the episode, N), Knollenorgans on "
                      "(groupsize)", grows),
@@ -89,7 +89,7 @@ def c18(ctx: Context) -> list[Part]:
         # direction relative to the body, while the straight bearing is not observed
         note = "partly by construction: the Knollenorgan signs encode the field direction, the bearing is unobserved"
         return dataclasses.replace(out, reason="; ".join(r for r in (out.reason, note) if r))
-    return [ctx.part("err vs bearing", "median over episodes of held-out decoding skill (1 - MSE / MSE of the "
+    return [ctx.part("err vs bearing", "Hodges-Lehmann estimate over episodes of held-out decoding skill (1 - MSE / MSE of the "
                      "train mean) of err_knollen minus bearing to the target; Wilcoxon", compute)]
 
 
@@ -135,10 +135,10 @@ def c19(ctx: Context) -> list[Part]:
                               sub["episode"].to_numpy(), folds)
             parts.append(s.groupby("group", as_index=False)["skill"].mean().assign(target=name))
         return paired_difference(ctx, pd.concat(parts, ignore_index=True), "near", "far")
-    return [ctx.part("agent features best", "median over episodes of held-out skill of the best agent or "
+    return [ctx.part("agent features best", "Hodges-Lehmann estimate over episodes of held-out skill of the best agent or "
                      "Knollenorgan feature minus the best other sensed variable (wide2; turn, EOD, bite and size "
                      "excluded); Wilcoxon", ranking),
-            ctx.part("food near > far", f"median over episodes of held-out skill of food distance and bearing, "
+            ctx.part("food near > far", f"Hodges-Lehmann estimate over episodes of held-out skill of food distance and bearing, "
                      f"nearest pellet within {near_cm:g} cm minus beyond; Wilcoxon", food)]
 
 

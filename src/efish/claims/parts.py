@@ -20,13 +20,18 @@ import pandas as pd
 
 from ..analysis._tables import AGENT_EPISODE
 from ..analysis.dynamics import units
-from ..analysis.stats import mann_whitney, spearman, wilcoxon_paired
+from ..analysis.stats import mann_whitney, signed_rank_test, spearman
 from .context import Context
+from .intervals import (
+    holm_alpha,
+    rank_sum_interval,
+    signed_rank_interval,
+    smallest_p_rank_sum,
+    smallest_p_signed_rank,
+)
 from .statistics import (
     at_ceiling,
     equivalence_margin,
-    median_diff,
-    median_minus,
     ols,
     paired_vs_control,
     pooled_sd,
@@ -34,7 +39,6 @@ from .statistics import (
     slope,
     tost_paired,
     tost_unpaired,
-    wilcoxon_vs,
 )
 from .verdicts import Outcome
 
@@ -62,14 +66,46 @@ def from_row(row: pd.Series, sign: int | None, ci: tuple[float, float], note: st
     return Outcome(float(row["effect"]), float(row["p"]), int(row["n"]), sign, ci, reason or note)
 
 
+def signed_rank_outcome(ctx: Context, d, sign: int | None, p_adjusted: float | None = None, family: int = 1,
+                        units_: str = "episodes") -> Outcome:
+    """The signed-rank test of the differences ``d`` against 0 as an Outcome: the effect is their Hodges-Lehmann
+    estimate and the interval the shifts the test does not reject (:func:`efish.claims.intervals.signed_rank_interval`).
+
+    ``p_adjusted``: the comparison's Holm-adjusted p within a ``family`` of that many comparisons; the interval is
+    then taken at the level Holm tests it at, and the smallest reachable p is the family's. All-zero differences
+    test nothing: effect 0 and p 1 (the equivalence test of a "no difference" part still can hold).
+    """
+    d = np.asarray(d, np.float64)
+    d = d[np.isfinite(d)]
+    if d.size == 0:
+        raise ValueError(f"no {units_} with a finite difference")
+    alpha = ctx.cfg.analysis.claims_alpha
+    if not np.any(d):  # no difference at all is data, not a small n: the floor is what n differences could reach
+        return Outcome(0.0, 1.0, d.size, sign, (0.0, 0.0), f"no difference in any of the {d.size} {units_}",
+                       ci_method="no difference to invert",
+                       p_floor=min(1.0, family * smallest_p_signed_rank(d.size)))
+    floor = min(1.0, family * smallest_p_signed_rank(int(np.count_nonzero(d))))
+    p_raw = signed_rank_test(d, "two-sided")[1]
+    p = p_raw if p_adjusted is None else float(p_adjusted)
+    level = holm_alpha(alpha, p_raw, p)
+    interval = signed_rank_interval(d, level)
+    method = f"inverts the signed-rank test at {level:.3g}" + (f" (Holm over {family})" if family > 1 else "")
+    return Outcome(interval.estimate, p, d.size, sign, (interval.low, interval.high), ci_method=method,
+                   p_floor=floor)
+
+
 def mann_whitney_part(ctx: Context, frame: pd.DataFrame, value: str, group: str, a, b, sign: int | None) -> Outcome:
-    """Mann-Whitney of ``value``, group ``a`` vs ``b`` (effect: median difference a - b), interval over episodes."""
+    """Mann-Whitney of ``value``, group ``a`` vs ``b``: effect the Hodges-Lehmann shift a - b, interval the shifts
+    the test does not reject (:func:`efish.claims.intervals.rank_sum_interval`)."""
     present(frame, group, [a, b], f"finite {value}")
     sub = frame[frame[group].isin([a, b])]
     row = mann_whitney(sub, value, group, b).set_index("group").loc[a]
-    ci = ctx.ci(sub, median_diff(value, group, a, b), strata=group)
-    return from_row(row, sign, ci)
-
+    x, y = (sub.loc[sub[group] == g, value].to_numpy(np.float64) for g in (a, b))
+    x, y = x[np.isfinite(x)], y[np.isfinite(y)]
+    interval = rank_sum_interval(x, y, ctx.cfg.analysis.claims_alpha)
+    out = from_row(row, sign, (interval.low, interval.high))
+    return dataclasses.replace(out, effect=interval.estimate, ci_method="inverts the Mann-Whitney test",
+                               p_floor=smallest_p_rank_sum(x.size, y.size))
 
 
 def spearman_part(ctx: Context, frame: pd.DataFrame, x: str, y: str, sign: int | None) -> Outcome:
@@ -78,10 +114,10 @@ def spearman_part(ctx: Context, frame: pd.DataFrame, x: str, y: str, sign: int |
 
 
 def one_sample_part(ctx: Context, frame: pd.DataFrame, value: str, reference: float, sign: int,
-                units_: Iterable[str] = ("episode",)) -> Outcome:
-    """Wilcoxon of ``value`` against ``reference`` (effect: median - reference), interval over ``units_``."""
-    row = wilcoxon_vs(frame[value], reference)
-    return from_row(row, sign, ctx.ci(frame, median_minus(value, reference), units_))
+                    units_: str = "episodes") -> Outcome:
+    """Signed-rank test of ``value`` against ``reference``, one value per row of ``frame`` (effect: the
+    Hodges-Lehmann estimate of value - reference; :func:`signed_rank_outcome`)."""
+    return signed_rank_outcome(ctx, frame[value].to_numpy(np.float64) - reference, sign, units_=units_)
 
 
 def ols_part(ctx: Context, frame: pd.DataFrame, x: str, y: str, sign: int) -> Outcome:
@@ -100,56 +136,65 @@ def joined(ctx: Context, hidden: str, steps: str, columns: list[str]) -> tuple[p
 
 def paired_difference(ctx: Context, long: pd.DataFrame, better: str, worse: str, value: str = "skill",
                       key: str = "target", unit: str = "group", sign: int = +1) -> Outcome:
-    """Paired Wilcoxon over ``unit`` (episodes) of ``value`` where ``key`` is ``better`` minus where it is ``worse``
-    (e.g. two decoding targets' held-out skill), with an interval over the units."""
-    long = long.rename(columns={unit: "episode", key: "target", value: "skill"})
-    row = wilcoxon_paired(long, "skill", "target", worse, "episode").set_index("group").loc[better]
-    wide = long.pivot(index="episode", columns="target", values="skill")
-    diff = (wide[better] - wide[worse]).dropna().rename("diff").reset_index()
-    return from_row(row, sign, ctx.ci(diff, median_minus("diff", 0.0), strata=None))
+    """Signed-rank test over ``unit`` (episodes) of ``value`` where ``key`` is ``better`` minus where it is
+    ``worse`` (e.g. two decoding targets' held-out skill), units with both only (:func:`signed_rank_outcome`)."""
+    wide = long.pivot(index=unit, columns=key, values=value)
+    present(pd.DataFrame({key: list(wide.columns)}), key, [better, worse], f"{value}")
+    diff = (wide[better] - wide[worse]).dropna()
+    return signed_rank_outcome(ctx, diff.to_numpy(np.float64), sign)
 
 
 # ------------------------------------------------- paired and equivalence parts (paired tests, equivalence, ceilings)
-def margin_for(ctx: Context, control: np.ndarray, other: np.ndarray) -> tuple[float, str]:
-    """The equivalence margin of an "n.s." part from the config (:func:`efish.claims.statistics.equivalence_margin`)."""
+def margin_for(ctx: Context, control: np.ndarray, spread: float) -> tuple[float, float, str]:
+    """The equivalence margin of an "n.s." part from the config (:func:`efish.claims.statistics.equivalence_margin`),
+    with ``spread`` the SD it falls back on near a zero control."""
     a = ctx.cfg.analysis
-    c, o = (np.asarray(v, np.float64) for v in (control, other))
-    sd = pooled_sd(c[np.isfinite(c)], o[np.isfinite(o)])
-    return equivalence_margin(c, sd, a.claims_margin_fraction, a.claims_margin_sd)
+    return equivalence_margin(np.asarray(control, np.float64), spread, a.claims_margin_fraction, a.claims_margin_sd)
+
+
+def _with_margin(out: Outcome, margin: tuple[float, float, str], p_equiv: float, p_floor: float) -> Outcome:
+    """``out`` with its equivalence test: the TOST p within the margin, the margin and its ratio in the row."""
+    m, ratio, how = margin
+    note = f"margin +-{m:.3g} = {how} ({ratio:.0%} of the control's typical value)"
+    return dataclasses.replace(out, p_equiv=p_equiv, margin=m, margin_ratio=ratio, p_floor=p_floor,
+                               reason="; ".join(r for r in (out.reason, note) if r))
 
 
 def paired_part(ctx: Context, summary: pd.DataFrame, measure: str, condition: str, control: str,
-                sign: int, family: Iterable[str] | None = None) -> Outcome:
-    """``condition`` vs ``control`` paired over their shared episodes: Wilcoxon signed-rank, Holm-adjusted
-    over ``family`` (default: every condition of ``summary``) compared with the same control; effect = median paired
-    difference with a bootstrap interval over episodes. For ``sign`` 0 also the paired TOST within the margin."""
+                sign: int, family: Iterable[str]) -> Outcome:
+    """``condition`` vs ``control`` paired over their shared episodes (:func:`signed_rank_outcome`), the p
+    Holm-adjusted over ``family``: the conditions whose comparison with the same control on the same measure a
+    part tests. Not decidable at a floor (``measure`` 0 in every episode of both). For ``sign`` 0 also the paired
+    TOST within the margin, whose fallback spread is the SD of the paired differences."""
     present(summary, "condition", [condition, control], f"episodes with {measure}")
-    family = list(summary["condition"].unique()) if family is None else [*family, control]
-    rows = paired_vs_control(summary[summary["condition"].isin(family)], measure, control)
+    compared = [*dict.fromkeys([*family, condition])]
+    rows = paired_vs_control(summary[summary["condition"].isin([*compared, control])], measure, control)
     row = rows.set_index("group").loc[condition]
     wide = summary[summary["condition"].isin([condition, control])].pivot(index="episode", columns="condition",
                                                                           values=measure).astype(np.float64)
     both = wide[[condition, control]].dropna()
-    diff = (both[condition] - both[control]).rename("diff").reset_index()
-    ci = ctx.ci(diff, median_minus("diff", 0.0), strata=None)
-    note = f"paired over {len(both)} shared episodes, Holm over {len(rows)} conditions vs {control}"
-    out = from_row(row, sign, ci)
-    if out.reason.startswith("all paired differences are zero"):  # e.g. no condition ate anything: no evidence
-        return dataclasses.replace(out, verdict="not decidable", reason=f"{out.reason} ({note})")
-    if sign == 0:
-        margin, how = margin_for(ctx, both[control].to_numpy(), both[condition].to_numpy())
-        out = dataclasses.replace(out, p_equiv=tost_paired(diff["diff"].to_numpy(), margin), margin=margin)
-        note += f"; margin {margin:.3g} = {how}"
-    return dataclasses.replace(out, reason="; ".join(r for r in (out.reason, note) if r))
+    note = f"paired over {len(both)} shared episodes, Holm over {len(compared)} vs {control}"
+    if len(both) and not both.to_numpy().any():
+        return Outcome(np.nan, np.nan, len(both), sign, verdict="not decidable",
+                       reason=f"at a floor: {measure} is 0 in every episode of {condition} and {control} ({note})")
+    d = (both[condition] - both[control]).to_numpy()
+    size = int(np.isfinite(rows["p_raw"]).sum())
+    out = signed_rank_outcome(ctx, d, sign, p_adjusted=row["p"] if np.any(d) else None, family=max(size, 1))
+    out = dataclasses.replace(out, reason="; ".join(r for r in (out.reason, note) if r))
+    if sign != 0:
+        return out
+    margin = margin_for(ctx, both[control].to_numpy(), float(np.std(d, ddof=1)) if d.size > 1 else 0.0)
+    return _with_margin(out, margin, tost_paired(d, margin[0]), smallest_p_signed_rank(d.size, sides=1))
 
 
 def unpaired_equivalence(ctx: Context, frame: pd.DataFrame, value: str, group: str, a, b) -> Outcome:
-    """Mann-Whitney of ``value``, ``a`` vs ``b`` (the control), and the unpaired TOST within the margin."""
+    """Mann-Whitney of ``value``, ``a`` vs ``b`` (the control), and the unpaired TOST within the margin (fallback
+    spread: the pooled SD)."""
     out = mann_whitney_part(ctx, frame, value, group, a, b, 0)
     x, c = (frame.loc[frame[group] == g, value].to_numpy(np.float64) for g in (a, b))
-    margin, how = margin_for(ctx, c, x)
-    return dataclasses.replace(out, p_equiv=tost_unpaired(x, c, margin), margin=margin,
-                               reason="; ".join(r for r in (out.reason, f"margin {margin:.3g} = {how}") if r))
+    x, c = x[np.isfinite(x)], c[np.isfinite(c)]
+    margin = margin_for(ctx, c, pooled_sd(c, x))
+    return _with_margin(out, margin, tost_unpaired(x, c, margin[0]), smallest_p_rank_sum(x.size, c.size, sides=1))
 
 
 def ceiling(ctx: Context, summary: pd.DataFrame, food: pd.DataFrame, conditions: Iterable[str]) -> Outcome | None:

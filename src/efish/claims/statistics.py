@@ -2,8 +2,8 @@
 
 - :func:`bootstrap_ci`: a percentile interval over resampled units (episodes),
   each unit's rows kept together, optionally within strata (conditions).
-- :func:`ols`, :func:`slope`, :func:`wilcoxon_vs`: an OLS slope with its p, a
-  one-sample Wilcoxon; and the statistics a bootstrap recomputes per resample
+- :func:`ols`, :func:`slope`: an OLS slope with its p; and the statistics a
+  bootstrap recomputes per resample
   (:func:`median_diff`, :func:`mean_diff`, :func:`median_minus`, :func:`rho_of`).
 - :func:`paired_vs_control`: every condition against a control, paired over
   the episodes they share (Wilcoxon signed-rank), Holm-corrected over the
@@ -98,23 +98,6 @@ def slope(x, y) -> float:
         return np.nan
 
 
-def wilcoxon_vs(values, reference: float) -> pd.Series:
-    """Two-sided Wilcoxon signed-rank test of ``values`` against a constant: a :mod:`.stats` row.
-
-    Effect = median of (value - reference). Built as a paired test against a
-    column of the constant, so the tie and degenerate rules are those of
-    :func:`efish.analysis.stats.wilcoxon_paired`.
-    """
-    v = np.asarray(values, np.float64)
-    v = v[np.isfinite(v)]
-    if v.size == 0:
-        raise ValueError("no finite value to test")
-    pair = np.arange(v.size)
-    long = pd.DataFrame({"pair": np.r_[pair, pair], "role": ["value"] * v.size + ["reference"] * v.size,
-                         "v": np.r_[v, np.full(v.size, float(reference))]})
-    return wilcoxon_paired(long, "v", "role", "reference", "pair").iloc[0]
-
-
 # ------------------------------------------------------------------ statistics a bootstrap recomputes
 def median_diff(value: str, group: str, a, b) -> Callable[[pd.DataFrame], float]:
     """median(value | group == a) - median(value | group == b); NaN if a group is empty."""
@@ -177,23 +160,46 @@ def paired_vs_control(summary: pd.DataFrame, measure: str, control: str, conditi
 
 
 # ------------------------------------------------------------------ equivalence
-def equivalence_margin(control: np.ndarray, pooled_sd: float, fraction: float, sd_fraction: float) -> tuple[float, str]:
-    """The equivalence margin of an "n.s." part and how it was chosen.
+#: No equivalence margin is wider than this fraction of the control's typical value (rule 3): a margin as wide
+#: as the control itself would call an ablation that halves food "equivalent".
+MAX_MARGIN_RATIO = 0.5
+
+
+def typical_value(control: np.ndarray) -> float:
+    """The control's typical magnitude: |median|, or the mean |value| where the median is 0 (mostly-zero counts)."""
+    c = np.asarray(control, np.float64)
+    c = c[np.isfinite(c)]
+    med = abs(float(np.median(c))) if c.size else 0.0
+    return med if med > 0 else float(np.mean(np.abs(c))) if c.size else 0.0
+
+
+def equivalence_margin(control: np.ndarray, sd: float, fraction: float, sd_fraction: float) -> tuple[float, float, str]:
+    """The equivalence margin of an "n.s." part, its ratio to the control's typical value, and how it was chosen.
 
     ``fraction`` of the control's median, unless that median is near 0 (within
-    one pooled SD of it, where a relative margin shrinks to nothing): then
-    ``sd_fraction`` pooled SDs. ValueError when neither gives a positive margin.
+    one ``sd`` of it, where a relative margin shrinks to nothing): then
+    ``sd_fraction`` x ``sd`` (the SD of the paired differences for a paired
+    test, the pooled SD otherwise). Never wider than :data:`MAX_MARGIN_RATIO`
+    of the control's :func:`typical_value`. ValueError when no positive margin
+    results (a control that is 0 throughout).
+
+    >>> m, r, _ = equivalence_margin(np.array([10.0, 12, 14]), 20.0, 0.2, 0.5); round(m, 3), round(r, 3)
+    (6.0, 0.5)
     """
     c = np.asarray(control, np.float64)
     c = c[np.isfinite(c)]
     if c.size == 0:
         raise ValueError("no finite control value for an equivalence margin")
-    med = float(np.median(c))
-    if abs(med) > pooled_sd and fraction * abs(med) > 0:
-        return fraction * abs(med), f"{fraction:g} x control median {med:.3g}"
-    if sd_fraction * pooled_sd > 0:
-        return sd_fraction * pooled_sd, f"{sd_fraction:g} pooled SD ({pooled_sd:.3g}; control median {med:.3g} near 0)"
-    raise ValueError("no variation and a zero control median: no equivalence margin")
+    med, typical = float(np.median(c)), typical_value(c)
+    if typical <= 0:
+        raise ValueError("the control is 0 in every episode: no equivalence margin")
+    if abs(med) > sd and fraction * abs(med) > 0:
+        margin, how = fraction * abs(med), f"{fraction:g} x control median {med:.3g}"
+    else:
+        margin, how = sd_fraction * sd, f"{sd_fraction:g} SD ({sd:.3g}; control median {med:.3g} near 0)"
+    if margin > MAX_MARGIN_RATIO * typical or margin <= 0:
+        margin, how = MAX_MARGIN_RATIO * typical, f"{MAX_MARGIN_RATIO:g} x the control's typical value {typical:.3g}"
+    return margin, margin / typical, how
 
 
 def pooled_sd(a: np.ndarray, b: np.ndarray) -> float:
@@ -227,8 +233,10 @@ def tost_unpaired(x: np.ndarray, control: np.ndarray, margin: float) -> float:
     return float(max(lower, upper))
 
 
-def welch_tost(x: np.ndarray, control: np.ndarray, margin: float) -> tuple[float, float, float]:
-    """Difference of means (x minus control), its two-sided Welch p, and the Welch TOST p within ``margin``.
+def welch_tost(x: np.ndarray, control: np.ndarray, margin: float,
+               alpha: float = 0.05) -> tuple[float, float, float, tuple[float, float]]:
+    """Difference of means (x minus control), its two-sided Welch p, the Welch TOST p within ``margin``, and the
+    1 - ``alpha`` Welch interval of the difference (the one that inverts the two-sided test).
 
     For a quantity defined against an expectation (the excess Theil T is the
     observed minus the null's mean), the means are what the null equalises, so
@@ -239,10 +247,11 @@ def welch_tost(x: np.ndarray, control: np.ndarray, margin: float) -> tuple[float
     x, c = x[np.isfinite(x)], c[np.isfinite(c)]
     if x.size < 2 or c.size < 2:
         raise ValueError(f"fewer than 2 values per group for a t-test ({x.size}, {c.size})")
-    p = sps.ttest_ind(x, c, equal_var=False).pvalue
+    test = sps.ttest_ind(x, c, equal_var=False)
+    ci = test.confidence_interval(1 - alpha)
     lower = sps.ttest_ind(x + margin, c, equal_var=False, alternative="greater").pvalue
     upper = sps.ttest_ind(x - margin, c, equal_var=False, alternative="less").pvalue
-    return float(x.mean() - c.mean()), float(p), float(max(lower, upper))
+    return float(x.mean() - c.mean()), float(test.pvalue), float(max(lower, upper)), (float(ci.low), float(ci.high))
 
 
 # ------------------------------------------------------------------ inequality

@@ -37,10 +37,13 @@ import numpy as np
 VERDICTS = ("holds", "weaker", "fails", "not decidable", "not run")
 ROW_COLUMNS = ["claim", "panel", "statistic", "effect", "ci_low", "ci_high", "n", "p", "verdict", "reason"]
 #: One row per (claim, part) (:func:`part_rows`): the part's label, its statistic, the paper's sign (+1, -1; 0 for
-#: "no difference"; NaN for "any difference" or a part that did not run), its effect, interval, n, the p its
-#: verdict rests on, its verdict, whether it decides the claim, and its reason.
-PART_COLUMNS = ["claim", "part", "statistic", "sign", "effect", "ci_low", "ci_high", "n", "p", "verdict", "decides",
-                "reason"]
+#: "no difference"; NaN for "any difference" or a part that did not run), its effect, interval, how the interval
+#: was made (``ci_method``), n, the p its verdict rests on, the equivalence margin of a "no difference" part and
+#: its ratio to the control's typical value, its verdict, whether it decides the claim, and its reason.
+PART_COLUMNS = ["claim", "part", "statistic", "sign", "effect", "ci_low", "ci_high", "ci_method", "n", "p", "margin",
+                "margin_ratio", "verdict", "decides", "reason"]
+#: The fewest units (episodes, agent-episodes) a part needs to be tested at all; with fewer it is ``not run``.
+MIN_UNITS = 2
 NAN_CI = (np.nan, np.nan)
 
 
@@ -52,7 +55,11 @@ class Outcome:
     difference (holds when n.s.); None, any difference (holds when significant).
     ``verdict`` overrides the rule for a part decided by a criterion, not a test
     (or "not decidable" at a ceiling). For ``sign`` 0, ``p_equiv`` is the TOST
-    p within ``margin`` (in the effect's units) and ``p`` the difference test's.
+    p within ``margin`` (in the effect's units) and ``p`` the difference test's;
+    ``margin_ratio`` is the margin over the control's typical value.
+    ``ci_method`` says how ``ci`` was made (it inverts the test, or resamples).
+    ``p_floor`` is the smallest p the part's test can give at its n, after its
+    multiplicity correction: at or above alpha the part cannot be significant.
     """
 
     effect: float
@@ -64,6 +71,9 @@ class Outcome:
     verdict: str | None = None
     p_equiv: float = np.nan
     margin: float = np.nan
+    margin_ratio: float = np.nan
+    ci_method: str = ""
+    p_floor: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -81,6 +91,9 @@ class Part:
     reason: str = ""
     decides: bool = True
     sign: int | None = None
+    ci_method: str = ""
+    margin: float = np.nan
+    margin_ratio: float = np.nan
 
 
 def judge(effect: float, p: float, sign: int | None, alpha: float, p_equiv: float = np.nan,
@@ -113,10 +126,11 @@ def judge(effect: float, p: float, sign: int | None, alpha: float, p_equiv: floa
 
 
 def combined_verdict(verdicts: Iterable[str]) -> str:
-    """A claim's verdict from its deciding parts': any fails -> fails; all that could be decided hold -> holds;
-    a part not run (a missing table) makes holds weaker; nothing decidable -> not decidable; none ran -> not run.
+    """A claim's verdict from its deciding parts': any fails -> fails; every part holds -> holds; a part that
+    is weaker, not decidable or not run beside the others makes the claim weaker at best (what was not tested
+    cannot carry the claim); nothing decided -> not decidable; none ran -> not run.
 
-    >>> combined_verdict(["holds", "not decidable"]), combined_verdict(["holds", "not run"])
+    >>> combined_verdict(["holds", "holds"]), combined_verdict(["holds", "not decidable"])
     ('holds', 'weaker')
     >>> combined_verdict(["not decidable", "not run"]), combined_verdict(["weaker", "fails"])
     ('not decidable', 'fails')
@@ -127,7 +141,7 @@ def combined_verdict(verdicts: Iterable[str]) -> str:
         return "not decidable" if "not decidable" in v else "not run"
     if "fails" in decided:
         return "fails"
-    return "holds" if all(x in ("holds", "not decidable") for x in v) else "weaker"
+    return "holds" if all(x == "holds" for x in v) else "weaker"
 
 
 def _fmt(x: float) -> str:
@@ -162,5 +176,6 @@ def part_rows(claim: str, parts: Iterable[Part]) -> list[dict]:
     training, :mod:`efish.claims.stages`)."""
     return [{"claim": claim, "part": p.label, "statistic": p.statistic,
              "sign": np.nan if p.sign is None else float(p.sign), "effect": p.effect, "ci_low": p.ci[0],
-             "ci_high": p.ci[1], "n": p.n, "p": p.p, "verdict": p.verdict, "decides": p.decides, "reason": p.reason}
+             "ci_high": p.ci[1], "ci_method": p.ci_method, "n": p.n, "p": p.p, "margin": p.margin,
+             "margin_ratio": p.margin_ratio, "verdict": p.verdict, "decides": p.decides, "reason": p.reason}
             for p in parts]
