@@ -24,5 +24,5 @@ include: "workflow/rules/learning.smk"
 
 rule all:
     input:
-        all_targets(),
+        PLAN.targets(THIS_RUN),
     default_target: True

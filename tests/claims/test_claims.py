@@ -569,11 +569,12 @@ def test_c19_ignores_a_perfectly_decodable_turn_and_ranks_the_sensed_variables()
 
 
 def test_bootstrap_reruns_are_identical_and_the_seed_matters():
-    tables = c9(False)  # C9's interval resamples episodes (a Spearman rho)
-    first, again = cl.CLAIMS["C9"].run(tables, CFG), cl.CLAIMS["C9"].run(tables, CFG)
-    assert first == again
-    other = cl.CLAIMS["C9"].run(tables, cfg_with("analysis.claims_resamples=40", "analysis.claims_seed=7"))
-    assert (other["ci_low"], other["ci_high"]) != (first["ci_low"], first["ci_high"])
+    def theil_part(cfg):  # C8's Theil part: a Spearman rho over episodes, its interval a bootstrap
+        return next(p for p in cl.CLAIMS["C8"].assess(c8(False), cfg)[1] if p.label == "Theil ~ size Theil")
+    first, again = theil_part(CFG), theil_part(CFG)
+    assert first == again and first.ci_method.startswith("bootstrap")
+    other = theil_part(cfg_with("analysis.claims_resamples=40", "analysis.claims_seed=7"))
+    assert other.ci != first.ci
 
 
 def test_an_interval_that_inverts_its_test_does_not_move_with_the_resampling_seed():
@@ -816,3 +817,21 @@ def test_a_b_alone_control_that_ate_nothing_is_a_floor():
     row = cl.CLAIMS["C14"].run(tables, CFG)
     assert "B social, A_gt_B: not decidable" in row["reason"] and "at a floor" in row["reason"]
     assert row["verdict"] != "holds"
+
+
+# ------------------------------------------------------------------------- rule 1: the unit is the episode
+def test_an_effect_planted_on_one_episodes_many_bites_is_not_significant():
+    """The second audit: C7's 12 bites from 5 episodes gave p 0.0063 over bites and 0.31 over episodes. Here one
+    episode bites 300 times with the larger agent biting, eleven others bite 3 times each with no size effect:
+    pooled over bites the effect is overwhelming, over episodes it is one unit among twelve."""
+    from scipy.stats import wilcoxon
+
+    rng = np.random.default_rng(71)
+    rows = [{"condition": "control", "episode": 0, "size_difference": 0.2 + rng.normal(0, 0.05)} for _ in range(300)]
+    rows += [{"condition": "control", "episode": e, "size_difference": rng.normal(0, 0.3)}
+             for e in range(1, 12) for _ in range(3)]
+    bites = pd.DataFrame(rows)
+    assert wilcoxon(bites["size_difference"]).pvalue < 1e-10  # what a test over bites would say
+    tables = {**c7(False), A("interactions", "patchy4", "bite_sizes"): bites}
+    part = next(p for p in cl.CLAIMS["C7"].assess(tables, CFG)[1] if p.label == "biter larger, patchy4")
+    assert part.n == 12 and part.p > 0.05 and part.verdict == "weaker", (part.n, part.p, part.verdict)

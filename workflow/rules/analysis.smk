@@ -1,14 +1,14 @@
 # Analyses: one rule per analysis of efish.analysis.registry, one job per (analysis, assay), writing the tables the
 # registry declares (efish.layout.analysis_table). The DAG asks for the analyses of each assay of the scale whose
-# input tables that assay writes (common.smk: ASSAY_ANALYSES). The same rule per analysis, named
+# input tables that assay writes (efish.run_plan: RunPlan.assay_analyses). The same rule per analysis, named
 # top_seed_analysis_<analysis>, runs on a top seed's rerun assays in its copy of the layout (the analyses the
-# claims read there; common.smk: seed_analysis_assays), and stage_analysis_<analysis> on a training stage's
+# claims read there; RunPlan.seed_analysis_assays), and stage_analysis_<analysis> on a training stage's
 # (learning.smk).
 
 
 for analysis in ANALYSES.values():
-    variants = [(None, "", analysis.assays), (TOP_SEED, "top_seed_", seed_analysis_assays(analysis)),
-                (STAGE, "stage_", seed_analysis_assays(analysis) if STAGES else [])]
+    variants = [(None, "", analysis.assays), (TOP_SEED, "top_seed_", PLAN.seed_analysis_assays(analysis)),
+                (STAGE, "stage_", PLAN.seed_analysis_assays(analysis) if PLAN.stages.rerun else [])]
     for copy, prefix, assays in (v for v in variants if v[2]):
 
         rule:
@@ -17,13 +17,13 @@ for analysis in ANALYSES.values():
             input:
                 **analysis_inputs(analysis, copy),
             output:
-                **analysis_outputs(analysis, copy=copy),
+                **analysis_outputs(analysis, copy),
             log:
                 log(f"analysis/{analysis.name}/{{assay}}", copy),
             benchmark:
                 benchmark(f"analysis/{analysis.name}/{{assay}}", copy)
             params:
-                overrides=ARGS,
+                overrides=PLAN.args,
                 analysis=analysis.name,
                 tables=lambda wildcards, input: str(Path(input[0]).parent),
                 out=folder_of(analysis.outputs[0]),

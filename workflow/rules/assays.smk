@@ -13,11 +13,11 @@ rule assay:
     benchmark:
         benchmark("assays/{assay}")
     params:
-        overrides=ARGS,
+        overrides=PLAN.args,
         out=folder_of("steps"),
         policies=policy_args,
     wildcard_constraints:
-        assay="|".join(BUILDABLE_ASSAYS[False]) or "^$",
+        assay=any_of(PLAN.by_hidden(PLAN.buildable_assays, hidden=False)),
     conda:
         "../envs/efish.yaml"
     shell:
@@ -28,14 +28,14 @@ use rule assay as assay_with_hidden with:
     output:
         **assay_outputs(hidden=True),
     wildcard_constraints:
-        assay="|".join(BUILDABLE_ASSAYS[True]) or "^$",
+        assay=any_of(PLAN.by_hidden(PLAN.buildable_assays, hidden=True)),
 
 
 # The best-ranked seeds (scale.top_seeds, from the select_seed checkpoint's ranking) rerun assays with their own
 # checkpoint as the `selected` policy, each in its own copy of the layout (efish.layout.Run.top_seed): every top
 # seed runs scale.top_seed_assays for the supplement's top-seed panels, and each top seed other than the selected
-# one also runs every claim's assay (common.smk: SEED_CLAIM_ASSAYS) for its own claims table. The selected seed's
-# rules, whose inputs (assay_policies_input) read {seed}.
+# one also runs every claim's assay (efish.run_plan: RunPlan.seed_claim_assays) for its own claims table. They are
+# the selected seed's rules, whose inputs (assay_policies_input) read {seed}.
 use rule assay as top_seed_assay with:
     output:
         **assay_outputs(hidden=False, copy=TOP_SEED),
@@ -44,14 +44,14 @@ use rule assay as top_seed_assay with:
     benchmark:
         benchmark("assays/{assay}", TOP_SEED)
     wildcard_constraints:
-        assay="|".join(a for a in TOP_SEED_ASSAYS if a not in TOP_SEED_HIDDEN) or "^$",
+        assay=any_of(PLAN.by_hidden(PLAN.top_seed_assays, hidden=False)),
 
 
 use rule top_seed_assay as top_seed_assay_with_hidden with:
     output:
         **assay_outputs(hidden=True, copy=TOP_SEED),
     wildcard_constraints:
-        assay="|".join(TOP_SEED_HIDDEN) or "^$",
+        assay=any_of(PLAN.by_hidden(PLAN.top_seed_assays, hidden=True)),
 
 
 # The supplement's top-seed panels: the top seeds' episodes in scale.top_seed_assays, stacked with seed and rank.
@@ -66,7 +66,7 @@ rule top_seeds:
     benchmark:
         benchmark("seeds/{assay}")
     params:
-        overrides=ARGS,
+        overrides=PLAN.args,
     conda:
         "../envs/efish.yaml"
     shell:

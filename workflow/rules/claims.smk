@@ -20,7 +20,7 @@ rule claims:
     benchmark:
         benchmark("claims")
     params:
-        overrides=ARGS,
+        overrides=PLAN.args,
         results=folder_of("table", 1),
         seeds=seed_claims_args,
         out=folder_of("table"),
@@ -42,7 +42,7 @@ use rule claims as top_seed_claims with:
     benchmark:
         benchmark("claims", TOP_SEED)
     params:
-        overrides=ARGS,
+        overrides=PLAN.args,
         results=folder_of("table", 1),
         seeds="",
         out=folder_of("table"),

@@ -4,23 +4,23 @@
 # the figure's legend: each panel's caption and the tables it reads.
 
 
-for figure, panels in FIGURE_PANELS.items():
+for figure in PLAN.figure_panels:
 
     rule:
         name:
             f"figure_{figure}"
         input:
-            sorted({path for p in panels for path in panel_inputs(p)}),
+            PLAN.figure_inputs(figure, THIS_RUN),
         output:
-            [report_entry(figure, path) for path in figure_outputs(figure)],
+            [report_entry(figure, path) for path in PLAN.figure_outputs(figure, RULE_RUN)],
         log:
             log(f"figures/{figure}"),
         benchmark:
             benchmark(f"figures/{figure}")
         params:
-            overrides=ARGS,
+            overrides=PLAN.args,
             figure=figure,
-            legend=figure_legend(figure),
+            legend=PLAN.figure_legend(figure),
             out=lambda wildcards: str(Run(wildcards.run).figures),
             results=lambda wildcards: str(Run(wildcards.run).results),
         conda:

@@ -1,6 +1,6 @@
 # Claims along training (`snakemake learning`; in the default target where scale.learning is set): at each kept
-# training stage (common.smk: STAGES) the selected seed's stage_<k>.pt acts in every claim's assay, the claims'
-# analyses run on them (analysis.smk: stage_analysis_<analysis>) and the claims table is written, all in
+# training stage (efish.run_plan: RunPlan.stages) the selected seed's stage_<k>.pt acts in every claim's assay,
+# the claims' analyses run on them (analysis.smk: stage_analysis_<analysis>) and the claims table is written, all in
 # results/{run}/learning/stage_<k>/ (efish.layout.Run.stage). efish claims-by-stage stacks the stages' parts
 # (a last stage at fraction 1 is the run's own claims), tests each part's trend against env steps and draws them.
 
@@ -13,20 +13,20 @@ use rule assay as stage_assay with:
     benchmark:
         benchmark("assays/{assay}", STAGE)
     params:
-        overrides=STAGE_ARGS,
+        overrides=PLAN.stage_args,
         out=folder_of("steps"),
         policies=policy_args,
     wildcard_constraints:
-        assay="|".join(a for a in SEED_CLAIM_ASSAYS if a not in HIDDEN_ASSAYS) or "^$",
-        stage="|".join(map(str, STAGES)) or "^$",
+        assay=any_of(PLAN.by_hidden(PLAN.seed_claim_assays, hidden=False)),
+        stage=any_of(map(str, PLAN.stages.rerun)),
 
 
 use rule stage_assay as stage_assay_with_hidden with:
     output:
         **assay_outputs(hidden=True, copy=STAGE),
     wildcard_constraints:
-        assay="|".join(a for a in SEED_CLAIM_ASSAYS if a in HIDDEN_ASSAYS) or "^$",
-        stage="|".join(map(str, STAGES)) or "^$",
+        assay=any_of(PLAN.by_hidden(PLAN.seed_claim_assays, hidden=True)),
+        stage=any_of(map(str, PLAN.stages.rerun)),
 
 
 use rule claims as stage_claims with:
@@ -41,7 +41,7 @@ use rule claims as stage_claims with:
     benchmark:
         benchmark("claims", STAGE)
     params:
-        overrides=ARGS,
+        overrides=PLAN.args,
         results=folder_of("table", 1),
         seeds="",
         out=folder_of("table"),
@@ -49,7 +49,7 @@ use rule claims as stage_claims with:
 
 rule claims_by_stage:
     input:
-        parts=stage_parts(),
+        parts=PLAN.stages.parts(RULE_RUN),
         policies=stage_policies,
         claims=results(CLAIMS_TABLE),
     output:
@@ -59,10 +59,10 @@ rule claims_by_stage:
     benchmark:
         benchmark("learning")
     params:
-        overrides=ARGS,
-        stages=lambda wildcards, input: keyed(input.parts),
-        policies=lambda wildcards, input: keyed(input.policies),
-        episodes=keyed(stage_episodes()),
+        overrides=PLAN.args,
+        stages=lambda wildcards, input: run_plan.keyed(PLAN.stages.kept, input.parts),
+        policies=lambda wildcards, input: run_plan.keyed(PLAN.stages.kept, input.policies),
+        episodes=run_plan.keyed(PLAN.stages.kept, PLAN.stages.episodes),
         out=folder_of("table"),
         figures=folder_of("png"),
     conda:

@@ -12,7 +12,7 @@ rule evaluate_seed:
     benchmark:
         benchmark(f"selection/{seed_name('{seed}')}")
     params:
-        overrides=ARGS,
+        overrides=PLAN.args,
         out=folder_of(0),
     conda:
         "../envs/efish.yaml"
@@ -22,7 +22,7 @@ rule evaluate_seed:
 
 checkpoint select_seed:
     input:
-        expand(results(selection_table("{seed}", "episodes")), seed=SEEDS, allow_missing=True),
+        expand(results(selection_table("{seed}", "episodes")), seed=PLAN.seeds, allow_missing=True),
     output:
         ranking=results(RANKING),
         seed=results(SELECTED_SEED),
@@ -31,7 +31,7 @@ checkpoint select_seed:
     benchmark:
         benchmark("select_seed")
     params:
-        overrides=ARGS,
+        overrides=PLAN.args,
         out=folder_of("ranking"),
     conda:
         "../envs/efish.yaml"

@@ -25,6 +25,8 @@ from ..layout import parse_table
 from .statistics import bootstrap_ci
 from .verdicts import MIN_UNITS, Outcome, Part, combine, judge
 
+#: ``ci_method`` of an interval no test inverts: every such interval resamples episodes (:meth:`Context.ci`).
+BOOTSTRAP = "bootstrap percentile over episodes"
 #: A claim's input: table path under ``results/{run}/`` -> the table.
 Tables = Mapping[str, pd.DataFrame]
 
@@ -56,7 +58,8 @@ def evaluate(label: str, statistic: str, compute: Callable[[], Outcome], alpha: 
         return Part(label, statistic, reason=f"a table lacks the column or key {exc}", decides=decides)
     p = out.p_equiv if out.sign == 0 and out.verdict is None else out.p
     base = Part(label, statistic, float(out.effect), tuple(map(float, out.ci)), int(out.n), float(p), decides=decides,
-                sign=out.sign, ci_method=out.ci_method, margin=float(out.margin), margin_ratio=float(out.margin_ratio))
+                sign=out.sign, ci_method=out.ci_method or (BOOTSTRAP if np.isfinite(out.ci).all() else ""),
+                margin=float(out.margin), margin_ratio=float(out.margin_ratio))
 
     def judged(verdict: str, *why: str) -> Part:
         return dataclasses.replace(base, verdict=verdict, reason="; ".join(r for r in why if r))

@@ -15,14 +15,8 @@ from ..analysis._tables import AGENT_EPISODE, eod_rate
 from ..analysis.signalling import EVENTS, fit_power_law, peri_event_rate
 from ..layout import analysis_table, assay_table
 from .context import Context, claim
-from .parts import (
-    from_row,
-    ols_part,
-    one_sample_part,
-    spearman_part,
-    stat_row,
-)
-from .statistics import median_minus, rho_of, slope
+from .parts import one_sample_part, per_episode, slope_of, spearman_part, stat_row
+from .statistics import rho_of
 from .verdicts import Outcome, Part
 
 POWER_LAW, IDIS = analysis_table("signalling", "wide2", "power_law"), analysis_table("signalling", "wide2", "idis")
@@ -113,59 +107,62 @@ def c6(ctx: Context) -> list[Part]:
         near = curves[(lag >= e0) & (lag <= e1)].groupby("condition")["mean_hz"].mean()
         base = curves[(lag >= b0) & (lag <= b1)].groupby("condition")["mean_hz"].mean()
         diff = (near - base).dropna().rename("diff").reset_index()
-        # back to the real condition and episode, so the interval resamples episodes within each condition
-        # (with the agent-episode as its own stratum, every resample would be the data itself: a zero-width CI)
+        # back to the real condition and episode
         parts = diff["condition"].str.rsplit("|", n=2)
         diff["condition"], diff["episode"] = parts.str[0], parts.str[1]
-        return one_sample_part(ctx, diff, "diff", 0.0, +1)
-    stat = (f"Hodges-Lehmann estimate over agent-episodes of the mean EOD rate at lags [{e0}, {e1}] minus [{b0}, {b1}] steps of "
-            "the event (wide2); Wilcoxon vs 0")
+        # the agents of one episode are one unit: their mean change, tested across episodes
+        return one_sample_part(ctx, per_episode(diff, "diff"), "diff", 0.0, +1)
+    stat = (f"Hodges-Lehmann estimate over episodes of the agents' mean EOD rate at lags [{e0}, {e1}] minus "
+            f"[{b0}, {b1}] steps of the event (wide2); Wilcoxon vs 0")
     return [ctx.part(event, stat, functools.partial(compute, event)) for event in EVENTS]
 
 
-def size_roles(ctx: Context, assay: str, measure: str, sizes: str) -> Outcome:
-    """The interactions analysis's Wilcoxon of chaser/biter vs chased/bitten size, interval over its events."""
-    row = stat_row(ctx.table(analysis_table("interactions", assay, "size_tests")), measure=measure)
-    events = ctx.table(analysis_table("interactions", assay, sizes))
-    ci = ctx.ci(events.dropna(subset=["size_difference"]), median_minus("size_difference", 0.0))
-    return from_row(row, +1, ci)
+def size_roles(ctx: Context, assay: str, sizes: str) -> Outcome:
+    """Per episode, the mean size difference of its events (biter minus bitten, chaser minus chased; the
+    interactions analysis's ``sizes`` table), tested across episodes: one episode's many bites are one unit."""
+    events = ctx.table(analysis_table("interactions", assay, sizes)).dropna(subset=["size_difference"])
+    if events.empty:
+        raise ValueError(f"no event with a size difference in {assay}")
+    return one_sample_part(ctx, per_episode(events, "size_difference"), "size_difference", 0.0, +1)
 
 
 @claim("C7", "3K,L; 5M,N", "larger agents bite smaller ones; the win ratio rises with size",
-       [analysis_table("interactions", a, t) for a in ("patchy4", "square2") for t in ("size_tests", "bite_sizes")]
+       [analysis_table("interactions", a, "bite_sizes") for a in ("patchy4", "square2")]
        + [analysis_table("behaviour", "patchy4", "win_ratio")])
 def c7(ctx: Context) -> list[Part]:
-    stat = "median biter minus bitten size over bites; Wilcoxon signed-rank"
-    parts = [ctx.part(f"biter larger, {assay}", stat, functools.partial(size_roles, ctx, assay, "bite",
-                                                                         "bite_sizes"))
+    stat = ("Hodges-Lehmann estimate over episodes of the mean biter minus bitten size of the episode's bites; "
+            "Wilcoxon signed-rank")
+    parts = [ctx.part(f"biter larger, {assay}", stat, functools.partial(size_roles, ctx, assay, "bite_sizes"))
              for assay in ("patchy4", "square2")]
 
     def win() -> Outcome:
-        return ols_part(ctx, ctx.table(analysis_table("behaviour", "patchy4", "win_ratio")), "size", "win_ratio", +1)
-    return parts + [ctx.part("win ratio slope, patchy4", "OLS slope of win ratio on size over agent-episodes", win)]
+        ratios = ctx.table(analysis_table("behaviour", "patchy4", "win_ratio"))
+        return one_sample_part(ctx, per_episode(ratios, "slope", slope_of("size", "win_ratio")), "slope", 0.0, +1)
+    return parts + [ctx.part("win ratio slope, patchy4", "Hodges-Lehmann estimate over episodes of the OLS slope "
+                             "of win ratio on size across the episode's agents; Wilcoxon signed-rank", win)]
 
 
 @claim("C8", "3M,N", "larger agents eat more; Theil T of food tracks size inequality",
-       [analysis_table("behaviour", "patchy4", t) for t in ("food_vs_size", "food_per_agent", "theil")])
+       [analysis_table("behaviour", "patchy4", t) for t in ("food_per_agent", "theil")])
 def c8(ctx: Context) -> list[Part]:
     def food() -> Outcome:
-        row = ctx.table(analysis_table("behaviour", "patchy4", "food_vs_size")).iloc[0]
         per = ctx.table(analysis_table("behaviour", "patchy4", "food_per_agent"))
-        return from_row(row, +1, ctx.ci(per, lambda d: slope(d["size"], d["food_eaten"])))
+        return one_sample_part(ctx, per_episode(per, "slope", slope_of("size", "food_eaten")), "slope", 0.0, +1)
 
     def theil() -> Outcome:
         return spearman_part(ctx, ctx.table(analysis_table("behaviour", "patchy4", "theil")), "size_theil_t",
                              "theil_t", +1)
-    return [ctx.part("food ~ size", "OLS slope of food eaten on size over agent-episodes (patchy4)", food),
+    return [ctx.part("food ~ size", "Hodges-Lehmann estimate over episodes of the OLS slope of food eaten on size "
+                     "across the episode's agents (patchy4); Wilcoxon signed-rank", food),
             ctx.part("Theil ~ size Theil", "Spearman rho of episode Theil T(food) against Theil T(size) (patchy4; "
                      "OLS was decided by one high-leverage episode)", theil)]
 
 
 @claim("C9", "3O", "size correlates positively with EOD rate",
-       [analysis_table("behaviour", "patchy4", t) for t in ("size_tests", "eod_probability")])
+       [analysis_table("behaviour", "patchy4", "eod_probability")])
 def c9(ctx: Context) -> list[Part]:
     def compute() -> Outcome:
-        row = stat_row(ctx.table(analysis_table("behaviour", "patchy4", "size_tests")), measure="eod_probability")
         eod = ctx.table(analysis_table("behaviour", "patchy4", "eod_probability"))
-        return from_row(row, +1, ctx.ci(eod, rho_of("size", "eod_probability")))
-    return [ctx.part("rho", "Spearman rho(size, EOD probability) over agent-episodes (patchy4)", compute)]
+        return one_sample_part(ctx, per_episode(eod, "rho", rho_of("size", "eod_probability")), "rho", 0.0, +1)
+    return [ctx.part("rho", "Hodges-Lehmann estimate over episodes of the Spearman rho(size, EOD probability) "
+                     "across the episode's agents (patchy4); Wilcoxon signed-rank", compute)]

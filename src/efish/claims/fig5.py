@@ -138,8 +138,9 @@ def c16(ctx: Context) -> list[Part]:
     def timing() -> Outcome:
         bites = ctx.table(analysis_table("interactions", "square2", "bite_timing"))
         return one_sample_part(ctx, bites.dropna(subset=["phase"]), "phase", 0.5, -1)
-    return [ctx.part("chaser larger", "median chaser minus chased size over chasing bouts (square2); Wilcoxon",
-                     functools.partial(size_roles, ctx, "square2", "chase", "chase_sizes")),
+    return [ctx.part("chaser larger", "Hodges-Lehmann estimate over episodes of the mean chaser minus chased size "
+                     "of the episode's chasing bouts (square2); Wilcoxon signed-rank",
+                     functools.partial(size_roles, ctx, "square2", "chase_sizes")),
             ctx.part("bites early", "Hodges-Lehmann estimate of the normalised bite time in its bout minus 0.5; Wilcoxon", timing),
             ctx.part("confronting bites most", "Hodges-Lehmann estimate over episodes of the bite rate per pair-step within range, "
                      "confronting minus the next-highest class; Wilcoxon signed-rank", functools.partial(_confronting,

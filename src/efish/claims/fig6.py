@@ -20,42 +20,34 @@ from ..layout import analysis_table, assay_table
 from .context import Context, claim
 from .fig2 import HOMING_ELECTRIC, HOMING_STEPS
 from .fig3 import WIDE2_STEPS
-from .parts import (
-    from_row,
-    joined,
-    one_sample_part,
-    paired_difference,
-    spearman_part,
-    stat_row,
-)
-from .statistics import interaction_slope, median_diff, median_minus
+from .parts import joined, one_sample_part, paired_difference, per_episode, spearman_part
+from .statistics import interaction_slope, rho_of
 from .verdicts import Outcome, Part
 
 HOMING_HIDDEN, WIDE2_HIDDEN = assay_table("homing", "hidden"), assay_table("wide2", "hidden")
-GROUPSIZE_TESTS = analysis_table("dynamics", "groupsize", "size_tests")
 
 
 @claim("C17", "6A-C", "hidden dynamics are low-dimensional; D_eff grows with group size only with Knollenorgans",
-       [analysis_table("dynamics", a, "dimensionality") for a in ("patchy4", "groupsize")] + [GROUPSIZE_TESTS])
+       [analysis_table("dynamics", a, "dimensionality") for a in ("patchy4", "groupsize")])
 def c17(ctx: Context) -> list[Part]:
     a, width = ctx.cfg.analysis, ctx.cfg.train.hidden
 
     def low() -> Outcome:
         dims = ctx.table(analysis_table("dynamics", "patchy4", "dimensionality"))
         dims = dims.assign(fraction=dims["d_eff"] / width).dropna(subset=["fraction"])
-        return one_sample_part(ctx, dims, "fraction", a.claims_deff_fraction, -1)
+        return one_sample_part(ctx, per_episode(dims, "fraction"), "fraction", a.claims_deff_fraction, -1)
 
-    def per_episode() -> pd.DataFrame:
+    def groupsize_episodes() -> pd.DataFrame:
         """D_eff averaged over the agents of each groupsize episode (the episode is the unit)."""
         dims = groupsize_parts(ctx.table(analysis_table("dynamics", "groupsize", "dimensionality")))
         return (dims.groupby(["condition", "episode", "n_agents", "knollenorgans"], as_index=False)["d_eff"].mean()
                 .dropna(subset=["d_eff"]))
 
     def grows() -> Outcome:
-        return spearman_part(ctx, per_episode().query("knollenorgans == 'K'"), "n_agents", "d_eff", +1)
+        return spearman_part(ctx, groupsize_episodes().query("knollenorgans == 'K'"), "n_agents", "d_eff", +1)
 
     def interaction() -> Outcome:
-        d = per_episode()
+        d = groupsize_episodes()
         on = (d["knollenorgans"] == "K").to_numpy(np.float64)
         b, p, n = interaction_slope(d["n_agents"], d["d_eff"], on)
 
@@ -65,8 +57,8 @@ def c17(ctx: Context) -> list[Part]:
             except ValueError:
                 return np.nan
         return Outcome(b, p, n, +1, ctx.ci(d, stat))
-    return [ctx.part("low-dimensional", f"Hodges-Lehmann estimate of D_eff / width ({width}) minus {a.claims_deff_fraction} (patchy4); "
-                     "Wilcoxon", low),
+    return [ctx.part("low-dimensional", f"Hodges-Lehmann estimate over episodes of the agents' mean D_eff / width ({width}) "
+                     f"minus {a.claims_deff_fraction} (patchy4); Wilcoxon", low),
             ctx.part("D_eff grows with N, K on", "Spearman rho(mean D_eff of the episode, N), Knollenorgans on "
                      "(groupsize)", grows),
             ctx.part("growth larger with K than without", "OLS slope of episode D_eff on N with Knollenorgans on "
@@ -173,7 +165,8 @@ def c20(ctx: Context) -> list[Part]:
                 # shifts=1: only the first component's correlation is used, not the null
                 res = plsc(a[h].to_numpy()[keep], b[h].to_numpy()[keep], shifts=1, rng=ctx.rng)
                 rows.append({"condition": cond, "episode": ep, "bin": k, "r1": res["correlations"][0]})
-        return spearman_part(ctx, pd.DataFrame(rows).dropna(), "bin", "r1", -1)
+        per = per_episode(pd.DataFrame(rows).dropna(), "rho", rho_of("bin", "r1"))
+        return one_sample_part(ctx, per, "rho", 0.0, -1)
 
     def collapse() -> Outcome:
         t = ctx.table(WIDE2_PLSC).dropna(subset=["n_significant"])
@@ -185,36 +178,37 @@ def c20(ctx: Context) -> list[Part]:
         return Outcome(d, np.nan, int(near["n_steps"].iloc[0] + far["n_steps"].iloc[0]), -1, verdict=verdict,
                        reason=f"n_significant {int(near['n_significant'].iloc[0])} near, "
                               f"{int(far['n_significant'].iloc[0])} far (a criterion: no p, no interval)")
-    return [ctx.part("r1 falls with distance", "Spearman rho of the PLSC first-component correlation per episode "
-                     "and distance bin against the bin (wide2)", falls),
+    return [ctx.part("r1 falls with distance", "Hodges-Lehmann estimate over episodes of the Spearman rho of the "
+                     "episode's PLSC first-component correlation against its distance bin (wide2); Wilcoxon", falls),
             ctx.part("collapse beyond the last edge", "n_significant(farthest bin) minus n_significant(nearest bin), "
                      "pooled PLSC (wide2)", collapse)]
 
 
-POWER_TESTS, POWER_NEAR_FAR = (analysis_table("dynamics", "wide2", t) for t in ("power_tests", "power_near_far"))
+POWER_NEAR_FAR = analysis_table("dynamics", "wide2", "power_near_far")
 WIDE2_DIMS = analysis_table("dynamics", "wide2", "dimensionality")
 
 
 @claim("C21", "6I,J", "a nearby conspecific lowers wideband power; smaller agents carry more",
-       [POWER_TESTS, POWER_NEAR_FAR, WIDE2_DIMS, WIDE2_STEPS])
+       [POWER_NEAR_FAR, WIDE2_DIMS, WIDE2_STEPS])
 def c21(ctx: Context) -> list[Part]:
     a = ctx.cfg.analysis
 
     def near_far() -> Outcome:
-        """The dynamics analysis's Wilcoxon row; interval over agent-episodes of power_near_far."""
-        row = stat_row(ctx.table(POWER_TESTS), measure="near_far")
+        """Per episode, its agents' mean wideband power far minus near (power_near_far), across episodes."""
         wide = ctx.table(POWER_NEAR_FAR).pivot(index=AGENT_EPISODE, columns="where", values="wideband_power")
         wide = wide.reindex(columns=["near", "far"])
         diff = (wide["far"] - wide["near"]).dropna().rename("diff").reset_index()
-        return from_row(row, +1, ctx.ci(diff, median_minus("diff", 0.0), strata=None))
+        return one_sample_part(ctx, per_episode(diff, "diff"), "diff", 0.0, +1)
 
     def smaller() -> Outcome:
-        """The dynamics analysis's Mann-Whitney row; interval over episodes of the dimensionality table."""
-        row = stat_row(ctx.table(POWER_TESTS), measure="size")
+        """Per episode, the smaller agent's wideband power minus the larger's (paired within the episode)."""
         d = smaller_larger(ctx.table(WIDE2_DIMS), ctx.table(WIDE2_STEPS)).dropna(subset=["wideband_power"])
-        return from_row(row, +1, ctx.ci(d, median_diff("wideband_power", "role", "smaller", "larger"), strata="role"))
-    return [ctx.part("far > near", f"median over agent-episodes of wideband power with the conspecific beyond "
-                     f"{a.claims_far_cm:g} cm minus within {a.claims_near_cm:g} cm; Wilcoxon (dynamics power_tests)",
-                     near_far),
-            ctx.part("smaller carries more", "median wideband power of the smaller minus the larger agent per "
-                     "episode (wide2); Mann-Whitney (dynamics power_tests)", smaller)]
+        by_role = d.pivot_table(index=["condition", "episode"], columns="role", values="wideband_power")
+        by_role = by_role.reindex(columns=["smaller", "larger"]).dropna()
+        diff = (by_role["smaller"] - by_role["larger"]).rename("diff").reset_index()
+        return one_sample_part(ctx, diff, "diff", 0.0, +1)
+    return [ctx.part("far > near", f"Hodges-Lehmann estimate over episodes of the agents' mean wideband power with "
+                     f"the conspecific beyond {a.claims_far_cm:g} cm minus within {a.claims_near_cm:g} cm; Wilcoxon "
+                     "signed-rank", near_far),
+            ctx.part("smaller carries more", "Hodges-Lehmann estimate over episodes of the wideband power of the "
+                     "smaller minus the larger agent (wide2); Wilcoxon signed-rank", smaller)]

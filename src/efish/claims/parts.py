@@ -13,7 +13,7 @@ A statistic an analysis table already holds is read (:func:`stat_row`,
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 
 import numpy as np
 import pandas as pd
@@ -47,6 +47,27 @@ def present(frame: pd.DataFrame, column: str, values: Iterable, what: str) -> No
     """ValueError naming the values of ``column`` that ``frame`` lacks (a condition with no data)."""
     if missing := [v for v in values if v not in set(frame[column].dropna())]:
         raise ValueError(f"no {what} for {column} {missing}")
+
+
+EPISODE_KEYS = ["condition", "episode"]
+
+
+def per_episode(frame: pd.DataFrame, value: str, stat: Callable[[pd.DataFrame], float] | None = None) -> pd.DataFrame:
+    """One row per episode (condition, episode) of ``frame``'s units (agents, events, bins): the mean of ``value``,
+    or ``stat`` of the episode's rows (a slope, a correlation) named ``value``; episodes where it is undefined
+    (NaN) are dropped. Rule 1: a test then runs across episodes, never across the units inside them."""
+    keys = [k for k in EPISODE_KEYS if k in frame.columns]
+    if stat is None:
+        out = frame.groupby(keys, as_index=False)[value].mean()
+    else:
+        out = pd.DataFrame([{**dict(zip(keys, k if isinstance(k, tuple) else (k,), strict=True)), value: stat(g)}
+                            for k, g in frame.groupby(keys, sort=True)], columns=[*keys, value])
+    return out.dropna(subset=[value])
+
+
+def slope_of(x: str, y: str) -> Callable[[pd.DataFrame], float]:
+    """The OLS slope of ``y`` on ``x`` within a frame (NaN where undefined), e.g. one episode's agents."""
+    return lambda d: slope(d[x], d[y])
 
 
 def stat_row(rows: pd.DataFrame, **match) -> pd.Series:

@@ -3,8 +3,7 @@
 - :func:`bootstrap_ci`: a percentile interval over resampled units (episodes),
   each unit's rows kept together, optionally within strata (conditions).
 - :func:`ols`, :func:`slope`: an OLS slope with its p; and the statistics a
-  bootstrap recomputes per resample
-  (:func:`median_diff`, :func:`mean_diff`, :func:`median_minus`, :func:`rho_of`).
+  bootstrap recomputes per resample (:func:`mean_diff`, :func:`rho_of`).
 - :func:`paired_vs_control`: every condition against a control, paired over
   the episodes they share (Wilcoxon signed-rank), Holm-corrected over the
   conditions: the paired counterpart of Dunnett's many-to-one test. Conditions
@@ -99,23 +98,11 @@ def slope(x, y) -> float:
 
 
 # ------------------------------------------------------------------ statistics a bootstrap recomputes
-def median_diff(value: str, group: str, a, b) -> Callable[[pd.DataFrame], float]:
-    """median(value | group == a) - median(value | group == b); NaN if a group is empty."""
-    def stat(d: pd.DataFrame) -> float:
-        x, y = d.loc[d[group] == a, value].dropna(), d.loc[d[group] == b, value].dropna()
-        return float(x.median() - y.median()) if len(x) and len(y) else np.nan
-    return stat
-
-
 def mean_diff(value: str, group: str, a, b) -> Callable[[pd.DataFrame], float]:
     def stat(d: pd.DataFrame) -> float:
         x, y = d.loc[d[group] == a, value].dropna(), d.loc[d[group] == b, value].dropna()
         return float(x.mean() - y.mean()) if len(x) and len(y) else np.nan
     return stat
-
-
-def median_minus(value: str, reference: float) -> Callable[[pd.DataFrame], float]:
-    return lambda d: float(np.nanmedian(d[value])) - reference if d[value].notna().any() else np.nan
 
 
 def rho_of(x: str, y: str) -> Callable[[pd.DataFrame], float]:

@@ -1,12 +1,14 @@
 """Every panel the pipeline draws, gathered from the figure modules' ``PANELS`` lists.
 
-The workflow reads :data:`PANELS` to make one job per panel and one page per
-figure; adding a panel means writing its function and one
+The workflow draws the panels a scale can draw (:func:`drawable`), grouped by
+:func:`figures`, one job per figure with its page; adding a panel means writing its function and one
 :class:`~efish.figures.panel.Panel` entry in its module's ``PANELS``.
 Paths are relative to ``results/{run}``.
 """
 
 from __future__ import annotations
+
+from collections.abc import Iterable
 
 from . import fig1, fig2, fig3, fig4, fig5, fig6, supplement
 from .panel import Panel
@@ -19,10 +21,11 @@ if len(PANELS) != len(_ALL):  # two modules registering one key: the dict would 
 __all__ = ["PANELS", "Panel", "drawable", "figures", "panels_for"]
 
 
-def figures() -> dict[str, list[Panel]]:
-    """Panels grouped by figure, in registry order."""
+def figures(panels: Iterable[Panel] | None = None) -> dict[str, list[Panel]]:
+    """Panels grouped by figure, in their order: every registered panel, or those of ``panels`` (the workflow
+    groups :func:`drawable`'s so, one job per figure; efish.run_plan)."""
     grouped: dict[str, list[Panel]] = {}
-    for panel in PANELS.values():
+    for panel in PANELS.values() if panels is None else panels:
         grouped.setdefault(panel.figure, []).append(panel)
     return grouped
 
