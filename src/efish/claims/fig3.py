@@ -50,14 +50,21 @@ def c4(ctx: Context) -> list[Part]:
 WIDE2_STEPS = assay_table("wide2", "steps")
 
 
-def _kruskal_eta(d: pd.DataFrame) -> tuple[float, float, int]:
-    """Kruskal-Wallis of ``rate`` over ``bin``: epsilon^2 = (H - k + 1) / (n - k), p, n; NaN when undefined."""
-    samples = [g.to_numpy() for _, g in d.groupby("bin")["rate"]]
-    n, k = sum(len(s) for s in samples), len(samples)
-    if k < 2 or n <= k or np.ptp(d["rate"]) == 0:
-        return np.nan, np.nan, n
-    h, p = sps.kruskal(*samples)
-    return float((h - k + 1) / (n - k)), float(p), n
+def _friedman_w(per: pd.DataFrame) -> tuple[float, float, int, int]:
+    """Friedman test of the episodes' mean EOD rates across distance bins, the episode a block (rule 1):
+    Kendall's W = chi2 / (n (k - 1)), p, n episodes, k bins; NaN where undefined.
+
+    ``per``: one row per (condition, episode, bin) with ``rate``. Only the bins at least half the episodes reach
+    are compared, over the episodes that reach all of them (Friedman needs complete blocks)."""
+    # a bootstrap resample numbers its drawn episodes (_draw): an episode drawn twice is two blocks
+    blocks = ["_draw"] if "_draw" in per.columns else ["condition", "episode"]
+    wide = per.pivot_table(index=blocks, columns="bin", values="rate")
+    wide = wide.loc[:, wide.notna().mean() >= 0.5].dropna()
+    n, k = wide.shape
+    if k < 3 or n < 2 or np.all(wide.to_numpy() == wide.to_numpy()[:, :1]):
+        return np.nan, np.nan, n, k
+    chi2, p = sps.friedmanchisquare(*wide.to_numpy().T)
+    return float(chi2 / (n * (k - 1))), float(p), n, k
 
 
 @claim("C5", "3E-G", "the EOD rate varies with distance to agent, food and wall", [WIDE2_STEPS])
@@ -72,16 +79,20 @@ def c5(ctx: Context) -> list[Part]:
                                             bin=np.clip(np.searchsorted(edges, dist, side="right") - 1, 0,
                                                         a.rate_bins - 1))
         frame = frame[np.isfinite(frame["rate"]) & (dist >= edges[0]) & (dist <= edges[-1])]
-        # one sample per agent-episode and bin (its mean rate): steps of one episode are not independent
+        # each agent-episode's mean rate per bin (bins with enough steps), then the episode's agents averaged:
+        # steps of one episode are not independent, nor are its agents
         per = frame.groupby([*AGENT_EPISODE, "bin"])["rate"].agg(["mean", "size"])
         per = per[per["size"] >= a.min_samples]["mean"].rename("rate").reset_index()
+        per = per.groupby(["condition", "episode", "bin"], as_index=False)["rate"].mean()
         if per.empty:
             raise ValueError(f"no agent-episode has {a.min_samples} steps in a {to} distance bin")
-        eta, p, n = _kruskal_eta(per)
-        reason = "" if np.isfinite(p) else "fewer than 2 distance bins with data, or a constant rate"
-        return Outcome(eta, p, n, None, ctx.ci(per, lambda d: _kruskal_eta(d)[0]), reason)
-    stat = ("Kruskal-Wallis of the mean EOD rate per agent-episode and distance bin across the bins of "
-            "docs/methods/analyses.md#analysis-signalling (wide2); effect epsilon^2")
+        w, p, n, k = _friedman_w(per)
+        reason = (f"{k} distance bins over {n} episodes that reach them all" if np.isfinite(p) else
+                  "fewer than 3 distance bins reached by half the episodes, fewer than 2 such episodes, "
+                  "or a constant rate")
+        return Outcome(w, p, n, None, ctx.ci(per, lambda d: _friedman_w(d)[0]), reason)
+    stat = ("Friedman test of the episodes' mean EOD rate across the distance bins of "
+            "docs/methods/analyses.md#analysis-signalling (wide2), the episode a block; effect Kendall's W")
     return [ctx.part(to, stat, functools.partial(compute, to)) for to in ("agent", "food", "wall")]
 
 
