@@ -99,7 +99,8 @@ def test_interaction_slope_recovers_the_difference_of_slopes():
     x = np.tile(np.arange(1, 5.0), 30)
     on = np.repeat([0.0, 1.0], 60)
     y = 3 + np.where(on == 1, 2.0, 0.5) * x + rng.normal(0, 0.5, x.size)
-    b, p, n = interaction_slope(x, y, on)
+    b, p, n, (low, high) = interaction_slope(x, y, on)
+    assert low < b < high and (low > 0) == (p < 0.05)
     assert b == pytest.approx(1.5, abs=0.2) and p < 1e-6 and n == 120
     flat = 3 + 1.0 * x + rng.normal(0, 0.5, x.size)
     assert interaction_slope(x, flat, on)[1] > 0.01

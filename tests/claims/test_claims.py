@@ -569,12 +569,14 @@ def test_c19_ignores_a_perfectly_decodable_turn_and_ranks_the_sensed_variables()
 
 
 def test_bootstrap_reruns_are_identical_and_the_seed_matters():
-    def theil_part(cfg):  # C8's Theil part: a Spearman rho over episodes, its interval a bootstrap
-        return next(p for p in cl.CLAIMS["C8"].assess(c8(False), cfg)[1] if p.label == "Theil ~ size Theil")
-    first, again = theil_part(CFG), theil_part(CFG)
-    assert first == again and first.ci_method.startswith("bootstrap")
-    other = theil_part(cfg_with("analysis.claims_resamples=40", "analysis.claims_seed=7"))
-    assert other.ci != first.ci
+    def agent_part(cfg):  # C5's parts: a Friedman test, its Kendall's W interval a bootstrap over episodes
+        part = next(p for p in cl.CLAIMS["C5"].assess(c5(False), cfg)[1] if p.label == "agent")
+        assert part.ci_method.startswith("bootstrap")
+        return part.effect, part.ci, part.p
+    first, again = agent_part(CFG), agent_part(CFG)
+    assert first == again
+    other = agent_part(cfg_with("analysis.claims_resamples=40", "analysis.claims_seed=7"))
+    assert other[1] != first[1] and other[0] == first[0]
 
 
 def test_an_interval_that_inverts_its_test_does_not_move_with_the_resampling_seed():

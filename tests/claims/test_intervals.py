@@ -94,3 +94,20 @@ def test_the_smallest_reachable_p_is_that_of_complete_agreement():
     x, y = np.arange(5.0) + 10, np.arange(5.0)
     assert sps.mannwhitneyu(x, y).pvalue == pytest.approx(smallest_p_rank_sum(5, 5)) == 2 / math.comb(10, 5)
     assert smallest_p_signed_rank(0) == 1.0 and smallest_p_rank_sum(0, 4) == 1.0
+
+
+def test_the_fisher_z_interval_of_a_rank_correlation_agrees_with_its_test():
+    from efish.claims.intervals import smallest_p_rank_correlation, spearman_fisher_z
+
+    rng = np.random.default_rng(8)
+    for _ in range(200):
+        n = int(rng.integers(4, 40))
+        x = rng.normal(size=n)
+        rho = sps.spearmanr(x, rng.choice([0.0, 0.5, 1.0]) * x + rng.normal(size=n)).statistic
+        p, interval = spearman_fisher_z(rho, n, 0.05)
+        assert interval.low <= rho <= interval.high and not contradicts(p, interval.low, interval.high)
+    # a larger sample narrows the interval; too few units cannot be tested; 4 pairs cannot reach p < 0.05 exactly
+    assert np.ptp(spearman_fisher_z(0.5, 100, 0.05)[1][1:]) < np.ptp(spearman_fisher_z(0.5, 20, 0.05)[1][1:])
+    with pytest.raises(ValueError):
+        spearman_fisher_z(0.5, 3, 0.05)
+    assert smallest_p_rank_correlation(4) > 0.05 > smallest_p_rank_correlation(5)

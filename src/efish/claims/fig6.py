@@ -49,14 +49,8 @@ def c17(ctx: Context) -> list[Part]:
     def interaction() -> Outcome:
         d = groupsize_episodes()
         on = (d["knollenorgans"] == "K").to_numpy(np.float64)
-        b, p, n = interaction_slope(d["n_agents"], d["d_eff"], on)
-
-        def stat(s: pd.DataFrame) -> float:
-            try:
-                return interaction_slope(s["n_agents"], s["d_eff"], (s["knollenorgans"] == "K").to_numpy(float))[0]
-            except ValueError:
-                return np.nan
-        return Outcome(b, p, n, +1, ctx.ci(d, stat))
+        b, p, n, ci = interaction_slope(d["n_agents"], d["d_eff"], on, ctx.cfg.analysis.claims_alpha)
+        return Outcome(b, p, n, +1, ci, ci_method="inverts the t-test")
     return [ctx.part("low-dimensional", f"Hodges-Lehmann estimate over episodes of the agents' mean D_eff / width ({width}) "
                      f"minus {a.claims_deff_fraction} (patchy4); Wilcoxon", low),
             ctx.part("D_eff grows with N, K on", "Spearman rho(mean D_eff of the episode, N), Knollenorgans on "

@@ -3,7 +3,7 @@ with an interval over episodes.
 
 Each builder takes the claim's :class:`~efish.claims.context.Context` (its
 tables, config and seeded generator), runs one test (Mann-Whitney, Spearman, a
-one-sample or paired Wilcoxon, an OLS slope; paired tests against a control
+one-sample or paired Wilcoxon; paired tests against a control
 with Holm's correction; equivalence tests for "no difference" statements) and
 returns its Outcome; :func:`ceiling` says when a food test cannot be decided.
 A statistic an analysis table already holds is read (:func:`stat_row`,
@@ -26,16 +26,16 @@ from .intervals import (
     holm_alpha,
     rank_sum_interval,
     signed_rank_interval,
+    smallest_p_rank_correlation,
     smallest_p_rank_sum,
     smallest_p_signed_rank,
+    spearman_fisher_z,
 )
 from .statistics import (
     at_ceiling,
     equivalence_margin,
-    ols,
     paired_vs_control,
     pooled_sd,
-    rho_of,
     slope,
     tost_paired,
     tost_unpaired,
@@ -130,8 +130,15 @@ def mann_whitney_part(ctx: Context, frame: pd.DataFrame, value: str, group: str,
 
 
 def spearman_part(ctx: Context, frame: pd.DataFrame, x: str, y: str, sign: int | None) -> Outcome:
-    """Spearman rho of ``y`` with ``x`` over the rows of ``frame``, interval over episodes."""
-    return from_row(spearman(frame, x, y).iloc[0], sign, ctx.ci(frame, rho_of(x, y)))
+    """Spearman rho of ``y`` with ``x`` over the rows of ``frame`` (one per episode), tested by Fisher's z with the
+    interval that inverts it (:func:`efish.claims.intervals.spearman_fisher_z`)."""
+    row = spearman(frame, x, y).iloc[0]
+    rho, n = float(row["effect"]), int(row["n"])
+    if not np.isfinite(rho):
+        return from_row(row, sign, (np.nan, np.nan))
+    p, interval = spearman_fisher_z(rho, n, ctx.cfg.analysis.claims_alpha)
+    return Outcome(rho, p, n, sign, (interval.low, interval.high), ci_method="inverts the Fisher-z test",
+                   p_floor=smallest_p_rank_correlation(n))
 
 
 def one_sample_part(ctx: Context, frame: pd.DataFrame, value: str, reference: float, sign: int,
@@ -139,13 +146,6 @@ def one_sample_part(ctx: Context, frame: pd.DataFrame, value: str, reference: fl
     """Signed-rank test of ``value`` against ``reference``, one value per row of ``frame`` (effect: the
     Hodges-Lehmann estimate of value - reference; :func:`signed_rank_outcome`)."""
     return signed_rank_outcome(ctx, frame[value].to_numpy(np.float64) - reference, sign, units_=units_)
-
-
-def ols_part(ctx: Context, frame: pd.DataFrame, x: str, y: str, sign: int) -> Outcome:
-    """OLS slope of ``y`` on ``x`` with its p, interval over episodes."""
-    b, p, n = ols(frame[x], frame[y])
-    return Outcome(b, p, n, sign, ctx.ci(frame, lambda d: slope(d[x], d[y])))
-
 
 
 def joined(ctx: Context, hidden: str, steps: str, columns: list[str]) -> tuple[pd.DataFrame, list[str]]:

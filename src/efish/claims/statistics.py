@@ -294,9 +294,11 @@ def at_ceiling(summary: pd.DataFrame, food: pd.DataFrame, condition: str, share:
 
 
 # ------------------------------------------------------------------ interaction
-def interaction_slope(x: np.ndarray, y: np.ndarray, on: np.ndarray) -> tuple[float, float, int]:
+def interaction_slope(x: np.ndarray, y: np.ndarray, on: np.ndarray,
+                      alpha: float = 0.05) -> tuple[float, float, int, tuple[float, float]]:
     """Slope of y on x where ``on`` minus the slope where not, from one OLS fit y ~ 1 + x + on + x:on, with the
-    two-sided t-test p of the interaction coefficient and n; ValueError where the design cannot give it."""
+    two-sided t-test p of the interaction coefficient, n, and its 1 - ``alpha`` t interval (the one the test
+    inverts); ValueError where the design cannot give it."""
     x, y, on = (np.asarray(v, np.float64) for v in (x, y, on))
     keep = np.isfinite(x) & np.isfinite(y) & np.isfinite(on)
     x, y, on = x[keep], y[keep], on[keep]
@@ -310,8 +312,9 @@ def interaction_slope(x: np.ndarray, y: np.ndarray, on: np.ndarray) -> tuple[flo
         raise ValueError(f"too few points for an interaction ({len(y)})")
     resid = y - design @ coef
     sigma2 = resid @ resid / dof
-    se = np.sqrt(sigma2 * np.linalg.inv(design.T @ design)[3, 3])
+    se = float(np.sqrt(sigma2 * np.linalg.inv(design.T @ design)[3, 3]))
+    b = float(coef[3])
     if se == 0:
-        return float(coef[3]), 0.0 if coef[3] != 0 else 1.0, len(y)
-    p = 2 * sps.t.sf(abs(coef[3] / se), dof)
-    return float(coef[3]), float(p), len(y)
+        return b, 0.0 if b != 0 else 1.0, len(y), (b, b)
+    half = float(sps.t.ppf(1 - alpha / 2, dof)) * se
+    return b, float(2 * sps.t.sf(abs(b / se), dof)), len(y), (b - half, b + half)
