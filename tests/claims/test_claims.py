@@ -387,10 +387,15 @@ def c19(flip):
 
 
 def c20(flip):
-    n_sig = [0, 1, 3] if flip else [3, 1, 0]
-    plsc = pd.DataFrame({"condition": "control", "lo_cm": [0.0, 10.0, 100.0], "hi_cm": [10.0, 100.0, np.inf],
-                         "n_steps": 100, "n_significant": n_sig, "s_1": 1.0, "reason": ""})
-    return {**wide_pair(flip), A("dynamics", "wide2", "plsc"): plsc}
+    # the dynamics analysis's collapse row (its test is efish.analysis.plsc_tests's, tested there): 3 shared
+    # dimensions near and none far, or the reverse, over 8 episodes (exact permutation p 2/256)
+    near, far = (0.0, 3.0) if flip else (3.0, 0.0)
+    collapse = pd.DataFrame([{"condition": "control", "agent_a": 0, "agent_b": 1, "near_hi_cm": 10.0,
+                              "far_lo_cm": 100.0, "n_episodes": 8, "n_steps": 700, "near_significant": near,
+                              "far_significant": far, "count_difference": far - near, "effect": far - near,
+                              "p": 2 / 256, "p_less": 1 / 256 if not flip else 1.0, "n_assignments": 256,
+                              "exact": True, "reason": ""}])
+    return {**wide_pair(flip), A("dynamics", "wide2", "plsc_collapse"): collapse}
 
 
 def c21(flip):

@@ -20,6 +20,7 @@ from sklearn.metrics import r2_score
 from sklearn.model_selection import GroupKFold, cross_val_predict
 
 from ._tables import AGENT_EPISODE, DEFAULTS, EPISODE, RATE_HZ, nan_frame, require
+from .plsc_tests import plsc_collapse, shared_dimensions
 
 SUBSAMPLE_FRACTIONS = tuple(DEFAULTS.subsample_fractions)
 #: Steps columns of the world the hidden state has observed (docs/reference/tables.md; Fig 6E's sensed
@@ -241,27 +242,48 @@ def plsc(h_a: np.ndarray, h_b: np.ndarray, shifts: int = DEFAULTS.plsc_shifts,
 
 def plsc_by_distance(h_a: np.ndarray, h_b: np.ndarray, dist_cm: np.ndarray, edges_cm=tuple(DEFAULTS.plsc_edges_cm),
                      shifts: int = DEFAULTS.plsc_shifts, rng: np.random.Generator | int | None = None,
-                     percentile: float = DEFAULTS.plsc_percentile) -> pd.DataFrame:
+                     percentile: float = DEFAULTS.plsc_percentile, episodes: np.ndarray | None = None,
+                     draws: int = DEFAULTS.plsc_null_draws, alpha: float = DEFAULTS.claims_alpha) -> pd.DataFrame:
     """:func:`plsc` on the steps whose inter-agent distance falls in each bin (<= 10, 10-100, > 100 cm;
     docs/methods/analyses.md#analysis-dynamics).
 
     The steps of a bin are taken in time order and the null shifts them as one
     series. One row per bin: ``lo_cm``, ``hi_cm`` (bins are (lo, hi], the first
-    from 0 inclusive), ``n_steps``, ``n_significant``, the largest singular
-    value ``s_1`` and a reason (e.g. a bin with fewer than 10 steps).
+    from 0 inclusive), ``n_steps``, ``n_significant`` (the paper's procedure),
+    the largest singular value ``s_1``, ``n_shared`` and ``n_episodes`` and a
+    reason (e.g. a bin with fewer than 10 steps).
+
+    ``n_shared`` is the calibrated count of
+    :func:`efish.analysis.plsc_tests.shared_dimensions` (episode-swap null,
+    step-down, ``draws`` permutations, level ``alpha``) over the bin's steps
+    split by ``episodes`` (one label per step); NaN without ``episodes``. Its
+    draws come from a stream spawned from ``rng``, so ``n_significant`` is
+    the same with or without it.
     """
     dist = np.asarray(dist_cm, dtype=np.float64)
     if not len(dist) == len(h_a) == len(h_b):
         raise ValueError(f"h_a, h_b and dist_cm differ in length: {len(h_a)}, {len(h_b)}, {len(dist)}")
     rng = np.random.default_rng(rng)
+    calibrated = rng.spawn(1)[0]
     bounds = [-np.inf, *edges_cm, np.inf]
     rows = []
     for lo, hi in itertools.pairwise(bounds):
         keep = (dist > lo) & (dist <= hi)
         res = plsc(np.asarray(h_a)[keep], np.asarray(h_b)[keep], shifts, rng, percentile)
+        shared = {"n_significant": np.nan, "n_episodes": 0, "reason": ""}  # NaN without episode labels
+        if episodes is not None:
+            a, b = (by_episode(np.asarray(h)[keep], np.asarray(episodes)[keep]) for h in (h_a, h_b))
+            shared = shared_dimensions(a, b, draws, alpha, calibrated)
         rows.append({"lo_cm": max(lo, 0.0), "hi_cm": hi, "n_steps": int(keep.sum()),
-                     "n_significant": res["n_significant"], "s_1": res["singular_values"][0], "reason": res["reason"]})
+                     "n_significant": res["n_significant"], "s_1": res["singular_values"][0],
+                     "n_shared": shared["n_significant"], "n_episodes": shared["n_episodes"],
+                     "reason": res["reason"] or (f"n_shared: {shared['reason']}" if shared["reason"] else "")})
     return pd.DataFrame(rows)
+
+
+def by_episode(h: np.ndarray, episodes: np.ndarray) -> list[np.ndarray]:
+    """The rows of ``h`` split by ``episodes`` (one label per row), each in its original order; episodes sorted."""
+    return [h[episodes == e] for e in np.unique(episodes)]
 
 
 def subsample_table(hidden: pd.DataFrame, fractions=SUBSAMPLE_FRACTIONS, draws: int = DEFAULTS.subsample_draws,
@@ -337,28 +359,82 @@ def food_decode_table(hidden: pd.DataFrame, steps: pd.DataFrame, near_cm: float 
     return pd.concat(parts, ignore_index=True)[FOOD_DECODE_COLUMNS]
 
 
+def _pair_states(hidden: pd.DataFrame, steps: pd.DataFrame,
+                 agents: tuple[int, int]) -> tuple[pd.DataFrame, pd.DataFrame, np.ndarray] | None:
+    """Two agents' hidden rows at the steps both have one (same order: condition, episode, t) and their distance
+    from the steps table's positions; None when they share no step."""
+    keys = [*EPISODE, "t"]
+    pos = _with_steps(hidden, steps, ["x_cm", "y_cm"])
+    a, b = (pos[pos["agent"] == i].set_index(keys).sort_index() for i in agents)
+    shared = a.index.intersection(b.index)
+    if shared.empty:
+        return None
+    a, b = a.loc[shared], b.loc[shared]
+    dist = np.hypot(a["x_cm"].to_numpy(np.float64) - b["x_cm"].to_numpy(np.float64),
+                    a["y_cm"].to_numpy(np.float64) - b["y_cm"].to_numpy(np.float64))
+    return a, b, dist
+
+
 def plsc_table(hidden: pd.DataFrame, steps: pd.DataFrame, agents: tuple[int, int] = (0, 1),
                edges_cm=tuple(DEFAULTS.plsc_edges_cm), shifts: int = DEFAULTS.plsc_shifts,
-               rng: np.random.Generator | int | None = None,
-               percentile: float = DEFAULTS.plsc_percentile) -> pd.DataFrame:
-    """:func:`plsc_by_distance` of two agents' hidden states per condition (Fig 6G,H).
+               rng: np.random.Generator | int | None = None, percentile: float = DEFAULTS.plsc_percentile,
+               draws: int = DEFAULTS.plsc_null_draws, alpha: float = DEFAULTS.claims_alpha) -> pd.DataFrame:
+    """:func:`plsc_by_distance` of two agents' hidden states per condition (Fig 6G,H), with the calibrated
+    ``n_shared`` over their episodes.
 
     Uses the steps at which both ``agents`` have a hidden state, episode after
     episode in time order; their distance comes from the steps table's
     positions. One row per condition and distance bin, with ``agent_a`` and
     ``agent_b``; without a shared step, one NaN row with a reason.
     """
-    keys = [*EPISODE, "t"]
-    pos = _with_steps(hidden, steps, ["x_cm", "y_cm"])
-    a, b = (pos[pos["agent"] == i].set_index(keys).sort_index() for i in agents)
-    shared = a.index.intersection(b.index)
-    if shared.empty:
+    pair = _pair_states(hidden, steps, agents)
+    if pair is None:
         return nan_frame(f"agents {agents[0]} and {agents[1]} share no step", condition=np.nan, n_steps=0)
-    a, b, h = a.loc[shared], b.loc[shared], units(hidden)
-    dist = np.hypot(a["x_cm"].to_numpy(np.float64) - b["x_cm"].to_numpy(np.float64),
-                    a["y_cm"].to_numpy(np.float64) - b["y_cm"].to_numpy(np.float64))
-    rng, condition = np.random.default_rng(rng), shared.get_level_values("condition")
+    a, b, dist = pair
+    h, rng = units(hidden), np.random.default_rng(rng)
+    condition, episode = (a.index.get_level_values(k).to_numpy() for k in EPISODE)
     parts = [plsc_by_distance(a[h].to_numpy()[condition == c], b[h].to_numpy()[condition == c],
-                              dist[condition == c], edges_cm, shifts, rng, percentile).assign(condition=c)
+                              dist[condition == c], edges_cm, shifts, rng, percentile, episode[condition == c],
+                              draws, alpha).assign(condition=c)
              for c in sorted(set(condition))]
     return pd.concat(parts, ignore_index=True).assign(agent_a=agents[0], agent_b=agents[1])
+
+
+#: Columns of :func:`plsc_collapse_table` (docs/methods/analyses.md#analysis-dynamics).
+COLLAPSE_COLUMNS = ["condition", "agent_a", "agent_b", "near_hi_cm", "far_lo_cm", "n_episodes", "n_steps",
+                    "near_significant", "far_significant", "count_difference", "effect", "p", "p_less",
+                    "n_assignments", "exact", "reason"]
+
+
+def plsc_collapse_table(hidden: pd.DataFrame, steps: pd.DataFrame, agents: tuple[int, int] = (0, 1),
+                        edges_cm=tuple(DEFAULTS.plsc_edges_cm), draws: int = DEFAULTS.plsc_null_draws,
+                        alpha: float = DEFAULTS.claims_alpha, windows: int = 1,
+                        swaps: int = DEFAULTS.plsc_label_swaps,
+                        rng: np.random.Generator | int | None = None) -> pd.DataFrame:
+    """:func:`efish.analysis.plsc_tests.plsc_collapse` of two agents' hidden states per condition (Fig 6H, claim
+    C20): fewer shared dimensions in the farthest distance bin (> last edge) than in the nearest (<= first edge)?
+
+    Each episode's steps in each bin are taken in time order. ``windows``
+    windows of each episode's larger bin (one in the analysis: see
+    :func:`~efish.analysis.plsc_tests.plsc_collapse` for why). One row per
+    condition (columns :data:`COLLAPSE_COLUMNS`); without a shared step or
+    an edge, one NaN row with a reason.
+    """
+    pair = _pair_states(hidden, steps, agents) if len(edges_cm) else None
+    if pair is None:
+        reason = f"agents {agents[0]} and {agents[1]} share no step" if len(edges_cm) else "no distance bin edges"
+        return nan_frame(reason).reindex(columns=COLLAPSE_COLUMNS)
+    a, b, dist = pair
+    h, rng = units(hidden), np.random.default_rng(rng)
+    condition, episode = (a.index.get_level_values(k).to_numpy() for k in EPISODE)
+    rows = []
+    for c in sorted(set(condition)):
+        here = condition == c
+        ha, hb, d, ep = a[h].to_numpy()[here], b[h].to_numpy()[here], dist[here], episode[here]
+        near, far = d <= edges_cm[0], d > edges_cm[-1]
+        # every episode of the condition, so that near and far lists line up (an empty block where a bin has none)
+        blocks = [[x[mask & (ep == e)] for e in np.unique(ep)] for mask in (near, far) for x in (ha, hb)]
+        res = plsc_collapse(*blocks, draws=draws, alpha=alpha, windows=windows, swaps=swaps, rng=rng)
+        rows.append({"condition": c, "agent_a": agents[0], "agent_b": agents[1], "near_hi_cm": edges_cm[0],
+                     "far_lo_cm": edges_cm[-1], **res})
+    return pd.DataFrame(rows, columns=COLLAPSE_COLUMNS)

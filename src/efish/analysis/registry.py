@@ -41,7 +41,14 @@ from .behaviour import (
     theil_per_episode,
     win_ratios,
 )
-from .dynamics import decode_table, dynamics_table, food_decode_table, plsc_table, subsample_table
+from .dynamics import (
+    decode_table,
+    dynamics_table,
+    food_decode_table,
+    plsc_collapse_table,
+    plsc_table,
+    subsample_table,
+)
 from .dynamics_tests import power_near_far, power_tests, size_tests
 from .homing import ERROR_COLUMNS, compare_perception, error_histogram, error_vs_time, trajectory_shape
 from .interactions import bite_rate_by_class, bite_sizes, bite_timing, bouts, chase_sizes, label_counts, size_role_tests
@@ -221,7 +228,8 @@ def _onepatch(t: Tables, cfg: EfishConfig) -> Tables:
 # --------------------------------------------------------------- dynamics
 def _dynamics(t: Tables, cfg: EfishConfig) -> Tables:
     """Hidden-state dimensionality, power, unit subsampling, decoding (also of food near and far), PLSC of agents
-    0 and 1, and the tests of D_eff against group size and of wideband power by context (Fig 6)."""
+    0 and 1 with the test of fewer shared dimensions far than near, and the tests of D_eff against group size and of
+    wideband power by context (Fig 6)."""
     a, hidden, steps = cfg.analysis, t["hidden"], t["steps"]
     rng = np.random.default_rng(a.seed)
     dims = dynamics_table(hidden, a.variance_fraction, a.spectrogram_window, a.spectrogram_overlap, cfg.env.fps)
@@ -230,7 +238,10 @@ def _dynamics(t: Tables, cfg: EfishConfig) -> Tables:
             "subsampling": subsample_table(hidden, a.subsample_fractions, a.subsample_draws, rng),
             "decoding": decode_table(hidden, steps, folds=a.decode_folds),
             "food_decoding": food_decode_table(hidden, steps, a.claims_food_near_cm, a.decode_folds),
-            "plsc": plsc_table(hidden, steps, (0, 1), a.plsc_edges_cm, a.plsc_shifts, rng, a.plsc_percentile),
+            "plsc": plsc_table(hidden, steps, (0, 1), a.plsc_edges_cm, a.plsc_shifts, rng, a.plsc_percentile,
+                               a.plsc_null_draws, a.claims_alpha),
+            "plsc_collapse": plsc_collapse_table(hidden, steps, (0, 1), a.plsc_edges_cm, a.plsc_null_draws,
+                                                 a.claims_alpha, swaps=a.plsc_label_swaps, rng=rng),
             "condition_tests": dunnett_by_measure(dims, DYNAMICS_MEASURES, "condition", control, a.seed),
             "size_tests": size_tests(dims), **_power(hidden, steps, dims, cfg)}
 
@@ -265,8 +276,8 @@ ANALYSES: dict[str, Analysis] = {a.name: a for a in [
     Analysis("onepatch", _onepatch, ("steps", "conditions"), ("onepatch", "bot"),
              ("food_time_course", "reach_rates", "role_tests", "reach_tests"), ("role_tests", "reach_tests")),
     Analysis("dynamics", _dynamics, ("hidden", "steps"), ("patchy4", "wide2", "homing", "groupsize", "square2"),
-             ("dimensionality", "subsampling", "decoding", "food_decoding", "plsc", "condition_tests", "size_tests",
-              "power_near_far", "power_tests"), ("condition_tests", "size_tests", "power_tests")),
+             ("dimensionality", "subsampling", "decoding", "food_decoding", "plsc", "plsc_collapse", "condition_tests",
+              "size_tests", "power_near_far", "power_tests"), ("condition_tests", "size_tests", "power_tests")),
 ]}
 
 

@@ -20,6 +20,7 @@ from ..layout import analysis_table, assay_table
 from .context import Context, claim
 from .fig2 import HOMING_ELECTRIC, HOMING_STEPS
 from .fig3 import WIDE2_STEPS
+from .intervals import smallest_p_signed_rank
 from .parts import joined, one_sample_part, paired_difference, per_episode, spearman_part
 from .statistics import interaction_slope, rho_of
 from .verdicts import Outcome, Part
@@ -128,7 +129,7 @@ def c19(ctx: Context) -> list[Part]:
                      f"nearest pellet within {near_cm:g} cm minus beyond; Wilcoxon", food)]
 
 
-WIDE2_PLSC = analysis_table("dynamics", "wide2", "plsc")
+WIDE2_COLLAPSE = analysis_table("dynamics", "wide2", "plsc_collapse")
 
 
 def _pair_hidden(ctx: Context) -> tuple[pd.DataFrame, pd.DataFrame, list[str]]:
@@ -145,7 +146,7 @@ def _pair_hidden(ctx: Context) -> tuple[pd.DataFrame, pd.DataFrame, list[str]]:
 
 
 @claim("C20", "6G,H", "the PLSC first-component correlation falls with pair distance; significant dimensions "
-       "collapse beyond 100 cm", [WIDE2_HIDDEN, WIDE2_STEPS, WIDE2_PLSC])
+       "collapse beyond 100 cm", [WIDE2_HIDDEN, WIDE2_STEPS, WIDE2_COLLAPSE])
 def c20(ctx: Context) -> list[Part]:
     edges = [-np.inf, *ctx.cfg.analysis.plsc_edges_cm, np.inf]
 
@@ -163,19 +164,22 @@ def c20(ctx: Context) -> list[Part]:
         return one_sample_part(ctx, per, "rho", 0.0, -1)
 
     def collapse() -> Outcome:
-        t = ctx.table(WIDE2_PLSC).dropna(subset=["n_significant"])
-        near, far = t[t["lo_cm"] == t["lo_cm"].min()], t[np.isinf(t["hi_cm"])]
-        if near.empty or far.empty:
-            raise ValueError("the PLSC table has no nearest or no farthest distance bin with a result")
-        d = float(far["n_significant"].iloc[0] - near["n_significant"].iloc[0])
-        verdict = "holds" if d < 0 else "fails" if d > 0 else "weaker"
-        return Outcome(d, np.nan, int(near["n_steps"].iloc[0] + far["n_steps"].iloc[0]), -1, verdict=verdict,
-                       reason=f"n_significant {int(near['n_significant'].iloc[0])} near, "
-                              f"{int(far['n_significant'].iloc[0])} far (a criterion: no p, no interval)")
+        """The dynamics analysis's collapse test: calibrated shared dimensions far minus near at equal steps, a
+        permutation p over whole episodes (analysis/plsc_tests.py)."""
+        row = ctx.table(WIDE2_COLLAPSE).iloc[0]
+        reason = str(row["reason"]) if isinstance(row["reason"], str) else ""
+        if not np.isfinite(row["p"]):
+            raise ValueError(reason or "no collapse test result")
+        note = (f"shared dimensions {row['near_significant']:.3g} near, {row['far_significant']:.3g} far at "
+                f"{int(row['n_steps'])} steps each")
+        return Outcome(float(row["effect"]), float(row["p"]), int(row["n_episodes"]), -1,
+                       reason="; ".join(r for r in (note, reason) if r),
+                       p_floor=smallest_p_signed_rank(int(row["n_episodes"])))
     return [ctx.part("r1 falls with distance", "Hodges-Lehmann estimate over episodes of the Spearman rho of the "
                      "episode's PLSC first-component correlation against its distance bin (wide2); Wilcoxon", falls),
-            ctx.part("collapse beyond the last edge", "n_significant(farthest bin) minus n_significant(nearest bin), "
-                     "pooled PLSC (wide2)", collapse)]
+            ctx.part("collapse beyond the last edge", "calibrated shared dimensions (step-down, episode-swap null) "
+                     "beyond the last edge minus within the first, at equal steps per episode; permutation test "
+                     "over whole episodes (dynamics plsc_collapse, wide2)", collapse)]
 
 
 POWER_NEAR_FAR = analysis_table("dynamics", "wide2", "power_near_far")

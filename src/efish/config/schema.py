@@ -449,9 +449,14 @@ class AnalysisConfig:
     plsc_percentile: float = param(97.5, "PLSC: a component beats this percentile of the null to count", lo=0.0,
                                    hi=100.0)
     plsc_edges_cm: list = param([10.0, 100.0], "PLSC: distance bin edges, increasing (<= first, ..., > last), cm")
+    plsc_null_draws: int = param(99, "PLSC shared dimensions and collapse (dynamics plsc, plsc_collapse): episode "
+                                 "permutations of the episode-swap null per component", lo=1)
+    plsc_label_swaps: int = param(256, "PLSC collapse: near/far label assignments of the permutation test (all "
+                                  "2^episodes when that is no more)", lo=2)
     spectrogram_window: int = param(20, "wideband power: spectrogram window, steps", lo=1)
     spectrogram_overlap: int = param(10, "wideband power: overlap of consecutive windows, steps (< window)", lo=0)
-    seed: int = param(0, "seed of unit subsampling, PLSC null shifts and Dunnett's p-values", lo=0)
+    seed: int = param(0, "seed of unit subsampling, PLSC null shifts, permutations and windows, and Dunnett's "
+                      "p-values", lo=0)
     real_fish_idis: str = param("", "CSV or Parquet of real-fish IDIs (column idi_ms); empty: none, and the IDI "
                                 "tables say so in their reason column")
     # claims (docs/claims/index.md, ``efish claims``)
