@@ -9,6 +9,7 @@ import math
 import pandas as pd
 import pytest
 
+from efish.claims.recipe import RECIPE_COLUMNS, RECIPE_PART_COLUMNS
 from efish.claims.verdicts import PART_COLUMNS, ROW_COLUMNS
 from efish.cli import ReturnLog, _parser, _recipe_override, main
 
@@ -41,19 +42,28 @@ def seed_run(tmp_path, monkeypatch):
 
     def fixed(results, cfg):
         table = claims_rows({"C1": "holds", "C9": "holds"})
-        parts = table.rename(columns={"panel": "part"}).assign(sign=1.0, decides=True, ci_method="",
-                                                               margin=float("nan"), margin_ratio=float("nan"))
-        parts = parts[PART_COLUMNS]
-        return table, parts
+        return table, parts_rows(table)
 
     monkeypatch.setattr(claims, "claims_and_parts", fixed)
     run = tmp_path / "results" / "myrun"
     (run / "analysis" / "selection").mkdir(parents=True)
     pd.DataFrame({"seed": [3, 1, 7, 2]}).to_parquet(run / "analysis" / "selection" / "ranking.parquet")
-    for seed, verdicts in ((1, {"C1": "not run", "C9": "weaker"}), (7, {"C1": "not run", "C9": "holds"})):
-        (run / "seeds" / f"seed_{seed}" / "claims").mkdir(parents=True)
-        claims_rows(verdicts).to_parquet(run / "seeds" / f"seed_{seed}" / "claims" / "claims.parquet")
+    for seed, verdicts, effect in ((1, {"C1": "not run", "C9": "weaker"}, 0.2), (7, {"C1": "not run", "C9": "holds"},
+                                                                                 0.5)):
+        folder = run / "seeds" / f"seed_{seed}" / "claims"
+        folder.mkdir(parents=True)
+        table = claims_rows(verdicts).assign(effect=effect)
+        table.to_parquet(folder / "claims.parquet")
+        parts_rows(table).to_parquet(folder / "claim_parts.parquet")
     return run
+
+
+def parts_rows(table: pd.DataFrame) -> pd.DataFrame:
+    """A parts table (PART_COLUMNS) with one part per claim of a claims table (CLI tests)."""
+    parts = table.rename(columns={"panel": "part"}).assign(sign=1.0, decides=True, ci_method="", family=1,
+                                                           p_floor=0.0, margin=float("nan"),
+                                                           margin_ratio=float("nan"))
+    return parts[PART_COLUMNS]
 
 
 def seed_table(run, seed: int) -> str:
@@ -66,13 +76,22 @@ def test_efish_claims_adds_the_verdicts_of_the_other_top_seeds(seed_run, capsys)
                  "--ranking", str(seed_run / "analysis/selection/ranking.parquet"),
                  "--seed-claims", seed_table(seed_run, 7), seed_table(seed_run, 1)]) == 0
     table = pd.read_parquet(out / "claims.parquet").set_index("claim")
-    assert list(table.reset_index().columns) == [*ROW_COLUMNS[:9], "seed_verdicts", "seeds_agree", "reason"]
+    assert list(table.reset_index().columns) == [*ROW_COLUMNS[:2], *RECIPE_COLUMNS, *ROW_COLUMNS[2:9], "seed_verdicts",
+                                                 "seeds_agree", "reason"]
+    # the recipe: C9's effects 0.4 (seed 3), 0.2 and 0.5 over three seeds (t = 4.2, 2 df, p = 0.053); C1 ran at one
+    assert table.loc["C9", "recipe_seeds"] == 3 and table.loc["C9", "recipe_effect"] == pytest.approx(1.1 / 3)
+    assert table.loc["C9", "recipe_verdict"] == "weaker" and table.loc["C9", "recipe_p"] == pytest.approx(0.053, abs=1e-3)
+    assert table.loc["C1", "recipe_verdict"] == "not run"
+    recipe = pd.read_parquet(out / "recipe_parts.parquet")
+    assert list(recipe.columns) == RECIPE_PART_COLUMNS and recipe["seeds"].tolist() == ["3, 1, 7"] * 2
     assert table.loc["C9", "seed_verdicts"] == "seed 3: holds; seed 1: weaker; seed 7: holds"  # ranking order
     assert table.loc["C9", "seeds_agree"] == "2/3 hold, 1/3 weaker"
     assert "flips between seeds" in table.loc["C9", "reason"]
     assert table.loc["C1", "seeds_agree"] == "1/1 hold (other seeds: not run)"
     page = (out / "claims.md").read_text()
-    assert "| verdict | seeds_agree | reason |" in page and "| holds | 2/3 hold, 1/3 weaker |" in page
+    assert "| selected seed's verdict | seeds_agree | reason | recipe reason |" in page
+    assert "| holds | 2/3 hold, 1/3 weaker |" in page and "| C9 | 3O | weaker | 0.367 [" in page
+    assert "The recipe (its top seeds together): 1 weaker, 1 not run. The selected seed: 2 holds." in page
     assert "selected seed 3, other top seeds 1, 7" in page.splitlines()[0]
     assert "seeds_agree" in capsys.readouterr().out
 
@@ -96,9 +115,14 @@ def test_efish_claims_without_seed_tables_keeps_its_columns(seed_run):
     (["one=x.parquet"], "write SEED=PATH"),
     (["--ranking", "nowhere.parquet", "--seed-claims", "1=x.parquet"], "no seed ranking at nowhere.parquet"),
     (["3=SELF"], "seed 3 is the selected seed"),
+    (["2=NOPARTS"], "claim_parts.parquet does not exist"),
 ])
 def test_efish_claims_refuses_bad_seed_tables_in_one_line_and_writes_nothing(seed_run, capsys, seed_args, message):
     seed_args = [a.replace("SELF", str(seed_run / "seeds/seed_1/claims/claims.parquet")) for a in seed_args]
+    if "2=NOPARTS" in seed_args:  # a seed's claims table without its parts table beside it
+        (seed_run / "seeds/seed_2/claims").mkdir(parents=True)
+        claims_rows({"C1": "holds"}).to_parquet(seed_run / "seeds/seed_2/claims/claims.parquet")
+        seed_args = [f"2={seed_run / 'seeds/seed_2/claims/claims.parquet'}"]
     args = seed_args if seed_args[0].startswith("--") else ["--seed-claims", *seed_args]
     assert main(["claims", "scale=smoke", "--results", str(seed_run), *args]) == 2
     err = capsys.readouterr().err

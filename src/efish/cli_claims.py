@@ -17,6 +17,7 @@ from .layout import (
     CLAIMS_TRENDS,
     CLAIMS_TRENDS_PAGE,
     RANKING,
+    RECIPE_PARTS,
 )
 
 
@@ -35,27 +36,34 @@ def run_claims(args, cfg, started) -> None:
     table, parts = claims.claims_and_parts(results, cfg)
     header = (f"Claims of the paper at scale {cfg.scale.name} (run {results.name}), "
               f"{started.strftime('%Y-%m-%d %H:%M UTC')}")
+    written = {Path(CLAIM_PARTS).stem: parts}
     if seeds is not None:
+        from .claims.recipe import recipe_parts, with_recipe_verdicts
         from .claims.seeds import with_seed_verdicts
 
-        selected, others = seeds
+        selected, others, other_parts = seeds
         table = with_seed_verdicts(table, others, selected)
+        recipe = recipe_parts({selected: parts, **other_parts}, selected, cfg.analysis.claims_alpha)
+        table = with_recipe_verdicts(table, recipe)
+        written[Path(RECIPE_PARTS).stem] = recipe
         header += f"; selected seed {selected}" + (f", other top seeds {', '.join(map(str, others))}" if others else "")
     table_path, page_path = out / Path(CLAIMS_TABLE).name, out / Path(CLAIMS_PAGE).name
-    write_parquet_tables({table_path.stem: table, Path(CLAIM_PARTS).stem: parts}, out)
+    write_parquet_tables({table_path.stem: table, **written}, out)
     write_text_atomic(page_path, claims_markdown(table, header, trends))
     write_metadata(out, cfg, started, args, results=str(results),
               **({} if seeds is None else {"selected_seed": seeds[0], "other_seeds": list(seeds[1])}),
               **({} if args.trends is None else {"trends": str(args.trends)}))
-    shown = ["claim", "panel", "effect", "ci_low", "ci_high", "n", "p", "verdict"]
+    shown = ["claim", "panel", *["recipe_verdict"] * ("recipe_verdict" in table.columns), "effect", "ci_low",
+             "ci_high", "n", "p", "verdict"]
     print(table[shown + ["seeds_agree"] * ("seeds_agree" in table.columns)].to_string(
         index=False, float_format=lambda v: f"{v:.3g}"))
-    print(f"wrote {table_path}, {out / Path(CLAIM_PARTS).name} and {page_path}")
+    print(f"wrote {table_path}, {', '.join(str(out / f'{name}.parquet') for name in written)} and {page_path}")
 
 
 def _seed_claims(args, results: Path):
-    """(selected seed, {other seed: its claims table} in ranking order) from --ranking and --seed-claims, or None
-    when neither is given (the table keeps the columns of ROW_COLUMNS)."""
+    """(selected seed, {other seed: its claims table}, {other seed: its claim_parts table, read beside it}), the
+    seeds in ranking order, from --ranking and --seed-claims; None when neither is given (the table keeps the
+    columns of ROW_COLUMNS)."""
     from .io import read_parquet
 
     if args.seed_claims is None and args.ranking is None:
@@ -73,7 +81,12 @@ def _seed_claims(args, results: Path):
         raise ValueError(f"--seed-claims: seeds {unknown} are not in the ranking {ranking_path} "
                          f"(seeds {', '.join(map(str, ranking))})")
     ordered = sorted(paths, key=ranking.index)
-    return ranking[0], {s: read_parquet(paths[s], f"seed {s}'s claims table") for s in ordered}
+    parts = {s: paths[s].with_name(Path(CLAIM_PARTS).name) for s in ordered}
+    if lacking := [str(p) for p in parts.values() if not p.is_file()]:
+        raise ValueError(f"--seed-claims: {', '.join(lacking)} does not exist (efish claims writes "
+                         f"{Path(CLAIM_PARTS).name} beside claims.parquet; rerun it for those seeds)")
+    return (ranking[0], {s: read_parquet(paths[s], f"seed {s}'s claims table") for s in ordered},
+            {s: read_parquet(parts[s], f"seed {s}'s parts table") for s in ordered})
 
 
 def _keyed(items: Sequence[str] | None, flag: str, key: str, value: str, example: str) -> dict[int, str]:

@@ -230,6 +230,7 @@ class Run:
 
 # ------------------------------------------------ claims per part and along training (efish claims, claims-by-stage)
 CLAIM_PARTS = "claims/claim_parts.parquet"  # one row per part of each claim, beside claims.parquet
+RECIPE_PARTS = "claims/recipe_parts.parquet"  # each part decided over the top seeds (efish.claims.recipe)
 #: The claims along training (``efish claims-by-stage``): the stages' parts stacked and each part's trend, under
 #: ``results/<run>/``, and their figure (``.png``, ``.pdf``) under ``figures/<run>/``.
 CLAIMS_BY_STAGE = f"{LEARNING}/claims_by_stage.parquet"

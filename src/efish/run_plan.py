@@ -282,6 +282,15 @@ class RunPlan:
         return " ".join([self.args, shlex.quote(f"scale.max_episodes={self.cfg.scale.stage_episodes}")])
 
     @property
+    def top_seed_args(self) -> str:
+        """:attr:`args` for the top seeds' reruns: capped at ``scale.top_seed_episodes`` episodes per condition
+        (:attr:`args` itself where that cap is no lower than ``scale.max_episodes``)."""
+        scale = self.cfg.scale
+        if scale.top_seed_episodes >= scale.max_episodes:
+            return self.args
+        return " ".join([self.args, shlex.quote(f"scale.max_episodes={scale.top_seed_episodes}")])
+
+    @property
     def seeds(self) -> list[int]:
         """The foraging seeds trained: 1..``scale.seeds``."""
         return list(range(1, self.cfg.scale.seeds + 1))

@@ -16,6 +16,7 @@ import pytest
 
 from efish.analysis.selection import RANKING_COLUMNS
 from efish.bench.accuracy import COLUMNS
+from efish.claims.recipe import RECIPE_PART_COLUMNS
 from efish.config import run_name
 from efish.rollout.schema import SCHEMAS, check_file
 
@@ -192,6 +193,7 @@ def test_the_other_top_seeds_rerun_the_claims_assays_for_their_own_claims(tmp_pa
     assert "seeds/seed_2/claims" not in out  # the selected seed's claims are the run's own
     assert ("efish claims scale=smoke scale.top_seeds=2 --results results/smoke/seeds/seed_1 --out "
             "results/smoke/seeds/seed_1/claims" in out)
+    assert "results/smoke/seeds/seed_1/claims/claim_parts.parquet" in out  # the recipe's verdict reads seed 1's parts
     assert ("efish claims scale=smoke scale.top_seeds=2 --results results/smoke --out results/smoke/claims --ranking "
             "results/smoke/analysis/selection/ranking.parquet --seed-claims "
             "1=results/smoke/seeds/seed_1/claims/claims.parquet") in out
@@ -210,6 +212,10 @@ def test_the_claims_carry_the_verdicts_of_the_top_seeds(smoke_run):
                                                                           strict=True))
     assert not (run / "seeds" / f"seed_{selected}" / "claims").exists()  # the selected seed's are the run's own
     assert "| seeds_agree |" in (run / "claims/claims.md").read_text()
+    # one seed: the recipe's verdict (a test over seeds) is there and not run, its parts say why
+    assert (claims["recipe_verdict"] == "not run").all() and (claims["recipe_seeds"] <= 1).all()
+    recipe = pd.read_parquet(run / "claims/recipe_parts.parquet")
+    assert list(recipe.columns) == RECIPE_PART_COLUMNS and recipe["verdict"].isin(["not run", "not decidable"]).all()
 
 
 @pytest.mark.slow

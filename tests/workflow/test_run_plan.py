@@ -254,3 +254,11 @@ def test_a_narrower_scale_asks_for_less_in_its_own_folder(narrow):
     assert all(t.startswith(("results/mine/", "figures/mine/")) for t in targets)
     assert not any("homing" in t for t in targets)  # neither its assay, its analysis nor its clip
     assert len(plan.figure_panels) < len(figures())  # the figures drawn from other assays alone are left out
+
+
+def test_the_top_seeds_rerun_at_fewer_episodes_where_the_scale_caps_them(plans):
+    """The recipe's verdict wants more seeds at fewer episodes: the top seeds' reruns get scale.top_seed_episodes
+    (study: 12 of its 24), and no extra override where the cap is no lower than max_episodes (smoke's 2)."""
+    assert plans["study"].top_seed_args == "scale=study scale.max_episodes=12"
+    assert plans["laptop"].top_seed_args == "scale=laptop scale.max_episodes=6"
+    assert plans["smoke"].top_seed_args == plans["smoke"].args

@@ -35,10 +35,15 @@ use rule assay as assay_with_hidden with:
 # checkpoint as the `selected` policy, each in its own copy of the layout (efish.layout.Run.top_seed): every top
 # seed runs scale.top_seed_assays for the supplement's top-seed panels, and each top seed other than the selected
 # one also runs every claim's assay (efish.run_plan: RunPlan.seed_claim_assays) for its own claims table. They are
-# the selected seed's rules, whose inputs (assay_policies_input) read {seed}.
+# the selected seed's rules, whose inputs (assay_policies_input) read {seed}, at scale.top_seed_episodes episodes per
+# condition (more seeds at fewer episodes decide the recipe's verdict better: efish.claims.recipe).
 use rule assay as top_seed_assay with:
     output:
         **assay_outputs(hidden=False, copy=TOP_SEED),
+    params:
+        overrides=PLAN.top_seed_args,
+        out=folder_of("steps"),
+        policies=policy_args,
     log:
         log("assays/{assay}", TOP_SEED),
     benchmark:

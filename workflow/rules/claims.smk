@@ -3,7 +3,8 @@
 # "not run" with the missing table named (efish claims never fails on it).
 # Verdicts across seeds. Each top seed other than the selected one gets its own claims table from its rerun assays
 # (top_seed_claims, in its copy of the layout); the claims job adds their verdicts to the selected seed's as
-# seed_verdicts and seeds_agree ("3/3 hold"), in the ranking's order.
+# seed_verdicts and seeds_agree ("3/3 hold"), in the ranking's order, and decides each part over all top seeds
+# (recipe_parts.parquet; the claims table's recipe_* columns: efish.claims.recipe).
 
 
 rule claims:
@@ -11,9 +12,11 @@ rule claims:
         tables=claims_inputs,
         ranking=results(RANKING),
         seeds=other_seed_claims,
+        seed_parts=other_seed_parts,
     output:
         table=results(CLAIMS_TABLE),
         parts=results(CLAIM_PARTS),
+        recipe=results(RECIPE_PARTS),
         page=report(results(CLAIMS_PAGE), caption="../report/claims.rst", category="Claims"),
     log:
         log("claims"),

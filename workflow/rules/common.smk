@@ -14,6 +14,7 @@ from efish.layout import (
     CLAIMS_TABLE,
     ROLLOUT_TABLES,
     RANKING,
+    RECIPE_PARTS,
     SELECTED_SEED,
     Run,
     assay_table,
@@ -169,6 +170,11 @@ def other_top_seeds(wildcards):
 def other_seed_claims(wildcards):
     """The claims tables of the other top seeds, in ranking order (the claims rule combines them)."""
     return [results(CLAIMS_TABLE, top_seed_copy(seed), Run(wildcards.run)) for seed in other_top_seeds(wildcards)]
+
+
+def other_seed_parts(wildcards):
+    """The parts tables of the other top seeds (beside their claims tables; the recipe's verdict reads them)."""
+    return [results(CLAIM_PARTS, top_seed_copy(seed), Run(wildcards.run)) for seed in other_top_seeds(wildcards)]
 
 
 def seed_claims_args(wildcards, input):

@@ -59,7 +59,8 @@ def evaluate(label: str, statistic: str, compute: Callable[[], Outcome], alpha: 
     p = out.p_equiv if out.sign == 0 and out.verdict is None else out.p
     base = Part(label, statistic, float(out.effect), tuple(map(float, out.ci)), int(out.n), float(p), decides=decides,
                 sign=out.sign, ci_method=out.ci_method or (BOOTSTRAP if np.isfinite(out.ci).all() else ""),
-                margin=float(out.margin), margin_ratio=float(out.margin_ratio))
+                margin=float(out.margin), margin_ratio=float(out.margin_ratio), family=int(out.family),
+                p_floor=float(out.p_floor))
 
     def judged(verdict: str, *why: str) -> Part:
         return dataclasses.replace(base, verdict=verdict, reason="; ".join(r for r in why if r))

@@ -104,7 +104,7 @@ def signed_rank_outcome(ctx: Context, d, sign: int | None, p_adjusted: float | N
     if not np.any(d):  # no difference at all is data, not a small n: the floor is what n differences could reach
         return Outcome(0.0, 1.0, d.size, sign, (0.0, 0.0), f"no difference in any of the {d.size} {units_}",
                        ci_method="no difference to invert",
-                       p_floor=min(1.0, family * smallest_p_signed_rank(d.size)))
+                       p_floor=min(1.0, family * smallest_p_signed_rank(d.size)), family=family)
     floor = min(1.0, family * smallest_p_signed_rank(int(np.count_nonzero(d))))
     p_raw = signed_rank_test(d, "two-sided")[1]
     p = p_raw if p_adjusted is None else float(p_adjusted)
@@ -112,7 +112,7 @@ def signed_rank_outcome(ctx: Context, d, sign: int | None, p_adjusted: float | N
     interval = signed_rank_interval(d, level)
     method = f"inverts the signed-rank test at {level:.3g}" + (f" (Holm over {family})" if family > 1 else "")
     return Outcome(interval.estimate, p, d.size, sign, (interval.low, interval.high), ci_method=method,
-                   p_floor=floor)
+                   p_floor=floor, family=family)
 
 
 def mann_whitney_part(ctx: Context, frame: pd.DataFrame, value: str, group: str, a, b, sign: int | None) -> Outcome:

@@ -31,26 +31,48 @@ def _num(x: float) -> str:
     return f"{x:.3g}" if np.isfinite(x) else "-"
 
 
-def _effects(table: pd.DataFrame) -> list[str]:
-    """``effect [ci_low, ci_high]`` per row, the effect alone where there is no interval."""
+def _effects(table: pd.DataFrame, prefix: str = "") -> list[str]:
+    """``effect [ci_low, ci_high]`` per row (of the ``prefix``ed columns, e.g. ``recipe_``), the effect alone where
+    there is no interval."""
     return [f"{_num(e)} [{_num(lo)}, {_num(hi)}]" if np.isfinite(lo) else _num(e)
-            for e, lo, hi in zip(table["effect"], table["ci_low"], table["ci_high"], strict=True)]
+            for e, lo, hi in zip(table[f"{prefix}effect"], table[f"{prefix}ci_low"], table[f"{prefix}ci_high"],
+                                 strict=True)]
+
+
+def _counts(verdicts: pd.Series) -> str:
+    counts = verdicts.value_counts()
+    return ", ".join(f"{counts[v]} {v}" for v in VERDICTS if v in counts)
+
+
+def has_recipe(table: pd.DataFrame) -> bool:
+    """Whether a claims table carries the recipe's verdict (:mod:`efish.claims.recipe`)."""
+    return "recipe_verdict" in table.columns
 
 
 def claims_markdown(table: pd.DataFrame, header: str, trends: Mapping[str, str] | None = None) -> str:
-    """The claims table as markdown under a ``header`` line: claim, panel, statistic, effect [95% CI], n, p, verdict,
-    seeds_agree (when the table has it: the verdicts across the top seeds, :mod:`efish.claims.seeds`),
-    reason (what docs/claims/results.md quotes and the Snakemake report shows); with ``trends`` (claim -> line,
-    :func:`efish.claims.stages.trend_lines`) the section :func:`along_training` after it."""
-    shown = pd.DataFrame({
-        "claim": table["claim"], "panel": table["panel"], "statistic": table["statistic"],
-        "effect [95% CI]": _effects(table), "n": table["n"], "p": [_num(p) for p in table["p"]],
-        "verdict": table["verdict"]})
+    """The claims table as markdown under a ``header`` line.
+
+    With the recipe's verdict (:mod:`efish.claims.recipe`) it is the headline: claim, panel, recipe verdict,
+    recipe effect [CI] over its seeds; then the selected seed's statistic, effect [95% CI], n, p and verdict (the
+    paper's procedure), seeds_agree (each top seed's own verdict, :mod:`efish.claims.seeds`) and the reasons (what
+    docs/claims/results.md quotes and the Snakemake report shows). With ``trends`` (claim -> line,
+    :func:`efish.claims.stages.trend_lines`) the section :func:`along_training` follows."""
+    shown = pd.DataFrame({"claim": table["claim"], "panel": table["panel"]})
+    recipe = has_recipe(table)
+    if recipe:
+        shown["recipe verdict"] = table["recipe_verdict"]
+        shown["recipe effect [CI] (seeds)"] = [f"{e} ({k})" for e, k in zip(_effects(table, "recipe_"),
+                                                                            table["recipe_seeds"], strict=True)]
+    seed = "selected seed's " if recipe else ""
+    shown = shown.assign(**{"statistic": table["statistic"], f"{seed}effect [95% CI]": _effects(table),
+                            "n": table["n"], "p": [_num(p) for p in table["p"]], f"{seed}verdict": table["verdict"]})
     if "seeds_agree" in table.columns:
         shown["seeds_agree"] = table["seeds_agree"]
     shown["reason"] = table["reason"]
-    counts = table["verdict"].value_counts()
-    summary = ", ".join(f"{counts[v]} {v}" for v in VERDICTS if v in counts)
+    summary = _counts(table["verdict"])
+    if recipe:
+        shown["recipe reason"] = table["recipe_reason"]
+        summary = f"The recipe (its top seeds together): {_counts(table['recipe_verdict'])}. The selected seed: {summary}"
     page = f"{header}\n\n{summary}.\n\n{markdown_table(shown)}"
     return page if trends is None else f"{page}\n{along_training(trends)}"
 
@@ -82,13 +104,17 @@ def load_claims(where: str | Path, results_root: str | Path = RESULTS_ROOT) -> t
 
 
 def compare_claims(a: pd.DataFrame, b: pd.DataFrame, names: tuple[str, str] = ("A", "B")) -> pd.DataFrame:
-    """Two claims tables side by side, one row per claim: each run's verdict, seeds_agree (the verdicts across its
-    top seeds; '-' for a run whose table has no such column), effect [95% CI] and n, and whether the verdict moved.
-    A claim only one table has shows '-' on the other side."""
+    """Two claims tables side by side, one row per claim: each run's recipe verdict (its top seeds together,
+    :mod:`efish.claims.recipe`; '-' for a run whose table has none), its selected seed's verdict, seeds_agree (the
+    verdicts across its top seeds; '-' where absent), effect [95% CI] and n, and whether a verdict moved: ``moved``
+    marks the recipe verdict when both runs have one, else the selected seed's. A claim only one table has shows '-'
+    on the other side."""
     def side(t: pd.DataFrame, name: str) -> pd.DataFrame:
         agree = t["seeds_agree"] if "seeds_agree" in t.columns else "-"
-        return pd.DataFrame({"claim": t["claim"], "panel": t["panel"], f"{name} verdict": t["verdict"],
-                             f"{name} seeds_agree": agree, f"{name} effect [95% CI]": _effects(t), f"{name} n": t["n"]})
+        recipe = t["recipe_verdict"] if has_recipe(t) else "-"
+        return pd.DataFrame({"claim": t["claim"], "panel": t["panel"], f"{name} recipe": recipe,
+                             f"{name} verdict": t["verdict"], f"{name} seeds_agree": agree,
+                             f"{name} effect [95% CI]": _effects(t), f"{name} n": t["n"]})
 
     if names[0] == names[1]:
         names = (f"{names[0]} (A)", f"{names[1]} (B)")
@@ -97,6 +123,7 @@ def compare_claims(a: pd.DataFrame, b: pd.DataFrame, names: tuple[str, str] = ("
     number = out["claim"].str.extract(r"(\d+)$")[0].astype(float)  # C2 before C10
     out = out.assign(_order=number).sort_values(["_order", "claim"]).drop(columns="_order")
     out = out.astype(object).where(out.notna(), "-").reset_index(drop=True)  # a claim one run lacks: '-'
-    out["moved"] = np.where(out[f"{names[0]} verdict"] == out[f"{names[1]} verdict"], "", "*")
+    headline = "recipe" if has_recipe(a) and has_recipe(b) else "verdict"
+    out["moved"] = np.where(out[f"{names[0]} {headline}"] == out[f"{names[1]} {headline}"], "", "*")
     return out
 

@@ -42,7 +42,8 @@ def claims_and_parts(results: str | Path, cfg: EfishConfig,
         rows.append(row)
         parts += part_rows(c, found)
     return (pd.DataFrame(rows, columns=ROW_COLUMNS).astype({"n": "int64"}),
-            pd.DataFrame(parts, columns=PART_COLUMNS).astype({"n": "int64", "sign": "float64", "decides": bool}))
+            pd.DataFrame(parts, columns=PART_COLUMNS).astype({"n": "int64", "family": "int64", "sign": "float64",
+                                                                  "decides": bool}))
 
 
 def claims_table(results: str | Path, cfg: EfishConfig, claims: Iterable[str] | None = None) -> pd.DataFrame:

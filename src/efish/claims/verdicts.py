@@ -39,9 +39,12 @@ ROW_COLUMNS = ["claim", "panel", "statistic", "effect", "ci_low", "ci_high", "n"
 #: One row per (claim, part) (:func:`part_rows`): the part's label, its statistic, the paper's sign (+1, -1; 0 for
 #: "no difference"; NaN for "any difference" or a part that did not run), its effect, interval, how the interval
 #: was made (``ci_method``), n, the p its verdict rests on, the equivalence margin of a "no difference" part and
-#: its ratio to the control's typical value, its verdict, whether it decides the claim, and its reason.
-PART_COLUMNS = ["claim", "part", "statistic", "sign", "effect", "ci_low", "ci_high", "ci_method", "n", "p", "margin",
-                "margin_ratio", "verdict", "decides", "reason"]
+#: its ratio to the control's typical value, its verdict, whether it decides the claim, and its reason. ``family``
+#: is the number of comparisons its p is Holm-adjusted over (1: none) and ``p_floor`` the smallest p its test can
+#: give at its n after that correction (what the recipe's verdict, :mod:`efish.claims.recipe`, reads to tell a
+#: part too small to decide from one the data cannot carry).
+PART_COLUMNS = ["claim", "part", "statistic", "sign", "effect", "ci_low", "ci_high", "ci_method", "n", "p", "family",
+                "p_floor", "margin", "margin_ratio", "verdict", "decides", "reason"]
 #: The fewest units (episodes, agent-episodes) a part needs to be tested at all; with fewer it is ``not run``.
 MIN_UNITS = 2
 NAN_CI = (np.nan, np.nan)
@@ -60,6 +63,7 @@ class Outcome:
     ``ci_method`` says how ``ci`` was made (it inverts the test, or resamples).
     ``p_floor`` is the smallest p the part's test can give at its n, after its
     multiplicity correction: at or above alpha the part cannot be significant.
+    ``family``: the number of comparisons ``p`` is Holm-adjusted over (1: none).
     """
 
     effect: float
@@ -74,6 +78,7 @@ class Outcome:
     margin_ratio: float = np.nan
     ci_method: str = ""
     p_floor: float = 0.0
+    family: int = 1
 
 
 @dataclass(frozen=True)
@@ -94,6 +99,8 @@ class Part:
     ci_method: str = ""
     margin: float = np.nan
     margin_ratio: float = np.nan
+    family: int = 1
+    p_floor: float = np.nan
 
 
 def judge(effect: float, p: float, sign: int | None, alpha: float, p_equiv: float = np.nan,
@@ -176,6 +183,7 @@ def part_rows(claim: str, parts: Iterable[Part]) -> list[dict]:
     training, :mod:`efish.claims.stages`)."""
     return [{"claim": claim, "part": p.label, "statistic": p.statistic,
              "sign": np.nan if p.sign is None else float(p.sign), "effect": p.effect, "ci_low": p.ci[0],
-             "ci_high": p.ci[1], "ci_method": p.ci_method, "n": p.n, "p": p.p, "margin": p.margin,
+             "ci_high": p.ci[1], "ci_method": p.ci_method, "n": p.n, "p": p.p, "family": p.family,
+             "p_floor": p.p_floor, "margin": p.margin,
              "margin_ratio": p.margin_ratio, "verdict": p.verdict, "decides": p.decides, "reason": p.reason}
             for p in parts]

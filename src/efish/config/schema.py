@@ -399,8 +399,13 @@ class ScaleConfig:
     selection_episodes: int = param(8, "patchy4 episodes per seed for seed selection "
                                     "(docs/methods/training.md#seed-selection)", lo=1)
     max_episode_steps: int = param(100_000, "cap on an assay episode's length (the smoke scale shortens them)", lo=1)
-    top_seeds: int = param(3, "the best-ranked seeds (the selected one first): the others rerun every claim's assays "
-                           "for seeds_agree, and all run the top_seed_assays (supplement)", lo=0)
+    top_seeds: int = param(4, "the best-ranked seeds (the selected one first): the others rerun every claim's assays "
+                           "for seeds_agree and the recipe's verdict over seeds, and all run the top_seed_assays "
+                           "(supplement)", lo=0)
+    top_seed_episodes: int = param(6, "cap on the episodes per assay condition of the top seeds' reruns (the "
+                                   "selected seed's own assays run max_episodes): more seeds at fewer episodes "
+                                   "decide the recipe's verdict better (docs/claims/index.md#the-recipes-verdict)",
+                                   lo=1)
     top_seed_assays: list = param(["patchy4", "wide2", "square2"], "assays the top seeds run")
     keep_stages: list = param([], "fractions of each seed's training at which it keeps its policy for the claims "
                               "along training (train.keep_stages reads it; [] = none)")

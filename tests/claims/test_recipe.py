@@ -1,0 +1,129 @@
+"""The recipe's verdict over the top seeds (efish.claims.recipe), on planted seed effects with known answers."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy import stats
+
+from efish.claims.recipe import RECIPE_COLUMNS, RECIPE_PART_COLUMNS, pooled, recipe_parts, with_recipe_verdicts
+from efish.claims.verdicts import PART_COLUMNS, ROW_COLUMNS
+
+ALPHA = 0.05
+
+
+def part_table(effects: dict[str, float], verdict: str = "weaker", sign: float = 1.0, claim: str = "C9", **extra):
+    """One seed's claim_parts table: one row per part label with the given effect."""
+    n = len(effects)
+    rows = pd.DataFrame({"claim": claim, "part": list(effects), "statistic": "a test", "sign": sign,
+                         "effect": list(effects.values()), "ci_low": np.nan, "ci_high": np.nan, "ci_method": "",
+                         "n": 8, "p": 0.2, "family": 1, "p_floor": 0.008, "margin": np.nan, "margin_ratio": np.nan,
+                         "verdict": verdict, "decides": True, "reason": ""}, index=range(n))
+    return rows.assign(**extra)[PART_COLUMNS]
+
+
+def seeds_of(effects, **kw) -> dict[int, pd.DataFrame]:
+    """Seed -> parts table for one part "a" with the seeds' ``effects`` (the first seed is the selected one)."""
+    return {seed: part_table({"a": e}, **kw) for seed, e in zip(range(1, len(effects) + 1), effects, strict=True)}
+
+
+def verdict_of(effects, **kw) -> pd.Series:
+    return recipe_parts(seeds_of(effects, **kw), 1, ALPHA).iloc[0]
+
+
+def test_pooled_is_the_t_test_over_the_seeds_effects():
+    y = np.array([0.3, 0.5, 0.2, 0.6, 0.4])
+    out = pooled(y, ALPHA)
+    t = stats.ttest_1samp(y, 0.0)
+    assert out.effect == pytest.approx(y.mean()) and out.p == pytest.approx(t.pvalue)
+    low, high = t.confidence_interval(0.95)
+    assert (out.low, out.high) == (pytest.approx(low), pytest.approx(high)) and out.tau == pytest.approx(y.std(ddof=1))
+    bonf = pooled(y, ALPHA, family=3)
+    assert bonf.p == pytest.approx(min(1.0, 3 * t.pvalue)) and bonf.low < low and bonf.high > high
+
+
+@pytest.mark.parametrize("effects, sign, expected", [
+    ([0.5, 0.45, 0.55, 0.5, 0.6], +1, "holds"),     # the paper's sign at every seed
+    ([-0.5, -0.45, -0.55, -0.5, -0.6], +1, "fails"),  # the opposite sign at every seed
+    ([0.02, -0.03, 0.01, -0.02, 0.01], +1, "weaker"),  # none
+    ([0.6, -0.6, 0.6, -0.6, 0.55], +1, "weaker"),  # seeds with opposite effects: heterogeneity is no recipe effect
+])
+def test_the_recipe_verdict_follows_the_planted_seed_effects(effects, sign, expected):
+    row = verdict_of(effects, sign=sign)
+    assert row["verdict"] == expected and row["n"] == 5
+    assert (row["ci_low"] > 0) == (expected == "holds") and (row["ci_high"] < 0) == (expected == "fails")
+
+
+def test_seeds_with_one_and_the_same_effect_are_decided_by_the_sign_test():
+    assert pooled([-1.0] * 4, ALPHA).p == pytest.approx(0.125)  # t is undefined: 2 / 2^4
+    assert pooled([-1.0] * 6, ALPHA).p == pytest.approx(0.03125) and pooled([0.0] * 6, ALPHA).p == 1.0
+    assert verdict_of([-1.0] * 4)["verdict"] == "weaker" and verdict_of([1.0] * 6)["verdict"] == "holds"
+
+
+def test_seeds_that_each_hold_in_opposite_directions_never_make_the_recipe_hold():
+    rng = np.random.default_rng(0)
+    verdicts = [verdict_of(np.r_[rng.normal(0.8, 0.1, 3), rng.normal(-0.8, 0.1, 2)], verdict="holds")["verdict"]
+                for _ in range(50)]
+    assert "holds" not in verdicts
+
+
+def test_with_no_effect_the_recipe_rejects_at_about_alpha():
+    rng = np.random.default_rng(1)
+    verdicts = pd.Series([verdict_of(rng.normal(0.0, 1.0, 4))["verdict"] for _ in range(400)])
+    assert verdicts.isin(["holds", "fails"]).mean() == pytest.approx(ALPHA, abs=0.03)
+    assert (verdicts == "holds").mean() < 0.05
+
+
+def test_correlations_combine_on_fishers_z_and_stay_correlations():
+    row = verdict_of([0.9, 1.0, 0.95], ci_method="inverts the Fisher-z test")
+    z = np.arctanh([0.9, 0.999, 0.95])
+    assert row["effect"] == pytest.approx(np.tanh(z.mean())) and -1 < row["ci_low"] < row["ci_high"] < 1
+    assert "Fisher-z" in row["ci_method"]
+
+
+def test_a_no_difference_part_holds_when_the_seeds_are_equivalent_and_fails_beyond_the_margin():
+    near = verdict_of([0.01, -0.02, 0.0, 0.02, -0.01], sign=0.0, margin=0.5)
+    assert near["verdict"] == "holds" and near["margin"] == 0.5
+    far = verdict_of([2.0, 2.1, 1.9, 2.05, 1.95], sign=0.0, margin=0.5)
+    assert far["verdict"] == "fails"
+
+
+def test_seeds_that_cannot_carry_the_part_are_left_out_and_named():
+    seeds = seeds_of([0.5, 0.55, 0.45, np.nan])
+    seeds[3] = part_table({"a": np.nan}, verdict="not decidable", p_floor=0.0)  # a ceiling: no effect
+    seeds[2] = part_table({"a": 0.45}, verdict="not decidable", p_floor=0.25)  # too few episodes: pooled
+    seeds[4] = part_table({"a": np.nan}, verdict="not run")
+    row = recipe_parts(seeds, 1, ALPHA).iloc[0]
+    assert row["n"] == 2 and row["seeds"] == "1, 2, 3, 4"
+    assert "left out: seed 3: not decidable; seed 4: not run" in row["reason"]
+    alone = recipe_parts({1: part_table({"a": 0.5}), 2: part_table({"a": np.nan}, verdict="not decidable",
+                                                                   p_floor=0.0)}, 1, ALPHA).iloc[0]
+    assert alone["verdict"] == "not decidable" and alone["n"] == 1
+    assert recipe_parts({1: part_table({"a": 0.5})}, 1, ALPHA).iloc[0]["verdict"] == "not run"
+
+
+def test_a_part_a_seed_lacks_is_not_run_there():
+    seeds = {1: part_table({"a": 0.5, "b": 0.5}), 2: part_table({"a": 0.6}), 3: part_table({"a": 0.55, "b": 0.4})}
+    out = recipe_parts(seeds, 1, ALPHA).set_index("part")
+    assert list(out.columns) == RECIPE_PART_COLUMNS[:1] + RECIPE_PART_COLUMNS[2:]
+    assert out.loc["a", "n"] == 3 and out.loc["b", "n"] == 2 and "seed 2: not run" in out.loc["b", "reason"]
+
+
+def test_the_claims_row_combines_the_recipe_parts_like_a_seeds_parts():
+    seeds = {s: part_table({"a": 0.5 + 0.02 * s, "b": (-1) ** s * 0.3}) for s in range(1, 6)}
+    recipe = recipe_parts(seeds, 1, ALPHA)
+    table = pd.DataFrame([{"claim": "C9", "panel": "3O", "statistic": "x", "effect": 0.5, "ci_low": 0.1,
+                           "ci_high": 0.9, "n": 8, "p": 0.01, "verdict": "holds", "reason": ""}], columns=ROW_COLUMNS)
+    out = with_recipe_verdicts(table, recipe)
+    assert list(out.columns) == [*ROW_COLUMNS[:2], *RECIPE_COLUMNS, *ROW_COLUMNS[2:]]
+    row = out.iloc[0]
+    assert row["recipe_verdict"] == "weaker" and row["recipe_seeds"] == 5  # a holds, b weaker
+    assert row["recipe_effect"] == pytest.approx(0.56) and row["verdict"] == "holds"  # the selected seed's stays
+
+
+def test_bad_parts_tables_are_one_line_errors():
+    with pytest.raises(ValueError, match="selected seed 9 has no claim_parts"):
+        recipe_parts(seeds_of([0.1, 0.2]), 9, ALPHA)
+    with pytest.raises(ValueError, match="lacks columns"):
+        recipe_parts({1: part_table({"a": 0.1}).drop(columns="p_floor"), 2: part_table({"a": 0.2})}, 1, ALPHA)
