@@ -405,13 +405,13 @@ def _figure(args, cfg, started) -> None:
     if args.key.startswith(f"{BENCH}/"):
         drawn = {args.key: redraw_bench_figure(args.key.split("/", 1)[1], results, out / BENCH)}
     elif "/" in args.key:
-        drawn = {args.key: render_panel(args.key, results, out, cfg.scale.seeds)}
+        drawn = {args.key: render_panel(args.key, results, out, cfg.scale.seed_numbers())}
     else:  # a figure: each of its panels and its page, from one reading of the tables
         if args.key not in figures():
             raise ValueError(f"unknown figure {args.key!r}: choose one of {', '.join(figures())}, "
                              f"{', '.join(f'{BENCH}/{n}' for n in BENCH_FIGURES)}")
         panels = [p for p in drawable(cfg.scale) if p.figure == args.key]
-        drawn = render_figure(args.key, panels, results, out, cfg.scale.seeds)
+        drawn = render_figure(args.key, panels, results, out, cfg.scale.seed_numbers())
     # one provenance per drawn output (a figure folder holds many panels), one config per folder
     for key, files in drawn.items():
         write_metadata(files[0].parent, cfg, started, args, name=f"{files[0].stem}.provenance.json", figure=key,

@@ -292,8 +292,8 @@ class RunPlan:
 
     @property
     def seeds(self) -> list[int]:
-        """The foraging seeds trained: 1..``scale.seeds``."""
-        return list(range(1, self.cfg.scale.seeds + 1))
+        """The foraging seeds trained (:meth:`efish.config.schema.ScaleConfig.seed_numbers`)."""
+        return self.cfg.scale.seed_numbers()
 
     @functools.cached_property
     def stages(self) -> Stages:
@@ -381,7 +381,7 @@ class RunPlan:
     def figure_inputs(self, figure: str, run: Run) -> list[str]:
         """Every table the panels of ``figure`` read in ``run`` (the expansion efish figure uses), sorted."""
         return sorted({str(path) for panel in self.figure_panels[figure]
-                       for paths in input_paths(panel, run.results, len(self.seeds)).values() for path in paths})
+                       for paths in input_paths(panel, run.results, self.seeds).values() for path in paths})
 
     def figure_outputs(self, figure: str, run: Run) -> list[str]:
         """Every file the job of ``figure`` writes: each panel's PNG and PDF, then the page's."""

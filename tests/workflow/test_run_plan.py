@@ -262,3 +262,13 @@ def test_the_top_seeds_rerun_at_fewer_episodes_where_the_scale_caps_them(plans):
     assert plans["study"].top_seed_args == "scale=study scale.max_episodes=12"
     assert plans["laptop"].top_seed_args == "scale=laptop scale.max_episodes=6"
     assert plans["smoke"].top_seed_args == plans["smoke"].args
+
+
+def test_a_seed_offset_trains_a_disjoint_set_of_seeds():
+    """scale.seed_offset (the stability run): the same recipe's seeds offset+1..offset+seeds, trained, selected
+    and drawn under their own numbers."""
+    plan = RunPlan.from_config({"scale": "smoke", "overrides": "scale.seed_offset=2", "run": "other"}, cache=None)
+    assert plan.seeds == [3, 4]
+    inputs = [path for figure in plan.figure_panels for path in plan.figure_inputs(figure, Run("other"))]
+    assert any("train/seed_3/" in t for t in inputs) and any("train/seed_4/" in t for t in inputs)
+    assert not any("train/seed_1/" in t or "train/seed_2/" in t for t in inputs)

@@ -385,7 +385,10 @@ class ScaleConfig:
     """How big a run is: smoke, laptop, study or paper (config/scale/)."""
 
     name: str = param("laptop", "name of the scale, used in output paths")
-    seeds: int = param(4, "foraging seeds trained (1..seeds)", lo=1)
+    seeds: int = param(4, "foraging seeds trained (seed_offset + 1 .. seed_offset + seeds)", lo=1)
+    seed_offset: int = param(0, "the trained seeds start after this one: a second run with offset = seeds draws "
+                             "a disjoint set of seeds of the same recipe (how stable its verdicts are, "
+                             "docs/claims/results.md)", lo=0)
     hidden: int = param(64, "network width (train.hidden reads it)", lo=1, hi=8192)
     num_envs: int = param(8, "parallel arenas per rollout (train.num_envs reads it)", lo=1)
     rollout_steps: int = param(400, "steps per foraging rollout (train.rollout_steps reads it)", lo=1)
@@ -418,6 +421,10 @@ class ScaleConfig:
     assays: list = param(["homing", "patchy4", "uniform4", "wide2", "square2", "ablation4", "ablation1",
                           "collective", "mute", "npatch", "food_scarcity", "onepatch", "bot", "groupsize"],
                          "assays the pipeline runs (names of config/assay/*.yaml)")
+
+    def seed_numbers(self) -> list[int]:
+        """The foraging seeds trained: ``seed_offset + 1`` .. ``seed_offset + seeds``."""
+        return list(range(self.seed_offset + 1, self.seed_offset + self.seeds + 1))
 
 
 # -------------------------------------------------------------------- analysis

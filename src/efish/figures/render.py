@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
 
 import pandas as pd
@@ -15,14 +16,22 @@ from .style import panel_style
 PANEL_SIZE_IN = (3.5, 2.8)
 
 
-def input_paths(panel: Panel, results: Path, seeds: int) -> dict[str, list[Path]]:
+Seeds = int | Sequence[int]  # the trained seeds' numbers, or their count n for seeds 1..n
+
+
+def seed_numbers(seeds: Seeds) -> list[int]:
+    """The seed numbers ``{seed}`` expands over: ``seeds`` itself, or 1..seeds for a count."""
+    return list(range(1, seeds + 1)) if isinstance(seeds, int) else [int(s) for s in seeds]
+
+
+def input_paths(panel: Panel, results: Path, seeds: Seeds) -> dict[str, list[Path]]:
     """Every file a panel reads (:attr:`Panel.tables`: its inputs and the conditions of its assays): ``{seed}``
-    expands over seeds 1..seeds."""
-    return {name: [results / path.format(seed=s) for s in range(1, seeds + 1)] if "{seed}" in path
+    expands over the trained seeds (:func:`seed_numbers`)."""
+    return {name: [results / path.format(seed=s) for s in seed_numbers(seeds)] if "{seed}" in path
             else [results / path] for name, path in panel.tables.items()}
 
 
-def check_inputs(panel: Panel, results: Path, seeds: int) -> None:
+def check_inputs(panel: Panel, results: Path, seeds: Seeds) -> None:
     """One clear error naming the first table of ``panel`` that does not exist (a missing conditions table: rerun
     the assay, which writes it)."""
     for name, paths in input_paths(panel, results, seeds).items():
@@ -33,17 +42,18 @@ def check_inputs(panel: Panel, results: Path, seeds: int) -> None:
                 raise ValueError(f"panel {panel.key} needs {path}, which does not exist ({hint})")
 
 
-def load_tables(panel: Panel, results: Path, seeds: int) -> dict[str, pd.DataFrame]:
+def load_tables(panel: Panel, results: Path, seeds: Seeds) -> dict[str, pd.DataFrame]:
     """The panel's tables (:attr:`Panel.tables`); a per-seed path gets a ``seed`` column. A missing file is one
     clear error (:func:`check_inputs`)."""
     check_inputs(panel, results, seeds)
     declared = panel.tables
-    return {name: pd.concat([read_parquet(path).assign(seed=seed) if "{seed}" in declared[name] else read_parquet(path)
-                             for seed, path in enumerate(paths, 1)], ignore_index=True)
+    numbers = seed_numbers(seeds)
+    return {name: pd.concat([read_parquet(path).assign(seed=numbers[i]) if "{seed}" in declared[name]
+                             else read_parquet(path) for i, path in enumerate(paths)], ignore_index=True)
             for name, paths in input_paths(panel, results, seeds).items()}
 
 
-def render_panel(key: str, results: Path, out: Path, seeds: int) -> list[Path]:
+def render_panel(key: str, results: Path, out: Path, seeds: Seeds) -> list[Path]:
     """Draw panel ``key`` (e.g. ``fig3/M``) into ``out/<figure>/<panel>.png`` and ``.pdf``."""
     panel = _panel(key)
     tables = load_tables(panel, results, seeds)
@@ -61,7 +71,7 @@ def draw_panel(panel: Panel, tables: dict[str, pd.DataFrame], plt):
     return fig
 
 
-def render_figure(figure: str, panels: list[Panel], results: Path, out: Path, seeds: int) -> dict[str, list[Path]]:
+def render_figure(figure: str, panels: list[Panel], results: Path, out: Path, seeds: Seeds) -> dict[str, list[Path]]:
     """Every panel of ``figure`` (``out/<figure>/<panel>.png`` and ``.pdf``) and its page (``out/<figure>.png``
     and ``.pdf``, the panels lettered by their ids), each panel's tables read once for both drawings and let go
     before the next panel's (a paper-scale steps table is large). Every input is checked to exist before anything
