@@ -221,9 +221,27 @@ def test_compare_claims_shows_each_runs_seeds_agree_and_a_dash_without(tmp_path,
     with_seeds.to_parquet(tmp_path / "new" / "claims.parquet")
     claims_rows({"C9": "weaker"}).to_parquet(tmp_path / "old" / "claims.parquet")
     assert main(["compare-claims", str(tmp_path / "new"), str(tmp_path / "old")]) == 0
-    header, row = capsys.readouterr().out.splitlines()
+    header, row, agreement = capsys.readouterr().out.splitlines()
     assert "new seeds_agree" in header and "old seeds_agree" in header
     assert "2/2 hold" in row and " - " in row and row.rstrip().endswith("*")
+    assert agreement.startswith("selected seeds' verdicts: the same for 0 of 1 claims")
+
+
+def test_compare_claims_counts_the_recipe_verdicts_that_agree_between_two_runs(tmp_path, capsys):
+    """The stability run's numbers: with the recipe's verdict in both tables, moved marks the recipe's and two
+    lines count the agreement of the recipe's and of the selected seeds' verdicts, naming holds-fails flips."""
+    rows = claims_rows({"C1": "holds", "C2": "weaker", "C3": "fails"})
+    a = rows.assign(recipe_verdict=["holds", "weaker", "holds"])
+    b = rows.assign(recipe_verdict=["holds", "fails", "fails"], verdict=["holds", "weaker", "holds"])
+    for name, t in (("a", a), ("b", b)):
+        (tmp_path / name).mkdir()
+        t.to_parquet(tmp_path / name / "claims.parquet")
+    assert main(["compare-claims", str(tmp_path / "a"), str(tmp_path / "b")]) == 0
+    *table, recipe, selected = capsys.readouterr().out.splitlines()
+    assert "a recipe" in table[0] and [line.rstrip().endswith("*") for line in table[1:]] == [False, True, True]
+    assert recipe == "recipe verdicts: the same for 1 of 3 claims; holds in one and fails in the other: C3 (a vs b)"
+    assert selected == ("selected seeds' verdicts: the same for 2 of 3 claims; holds in one and fails in the other: C3 "
+                        "(a vs b)")
 
 
 # ------------------------------------------------- dispatch: every (sub)command has a handler

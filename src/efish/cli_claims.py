@@ -166,7 +166,8 @@ def run_claims_by_stage(args, cfg, started) -> None:
 
 
 def run_compare_claims(args, cfg, started) -> None:
-    from .claims.report import compare_claims, load_claims
+    from .claims.report import agreement_lines, compare_claims, load_claims
 
     (name_a, a), (name_b, b) = load_claims(args.a), load_claims(args.b)
     print(compare_claims(a, b, (name_a, name_b)).to_string(index=False))
+    print("\n".join(agreement_lines(a, b, (name_a, name_b))))

@@ -720,8 +720,12 @@ def test_compare_claims_prints_both_runs_side_by_side(results, tmp_path, capsys)
     assert main(["compare-claims", str(tmp_path / "runa" / "claims"), str(tmp_path / "runb" / "claims.parquet")]) == 0
     text = capsys.readouterr().out
     assert "runa verdict" in text and "runb verdict" in text
-    lines = {line.split()[0]: line for line in text.splitlines()[1:]}
+    *table, agreement = text.splitlines()
+    lines = {line.split()[0]: line for line in table[1:]}
     assert list(lines) == ["C9", "C12"]
+    # the stability summary: C12 holds in one run and fails in the other
+    assert agreement == ("selected seeds' verdicts: the same for 0 of 1 claims; holds in one and fails in the other: "
+                         "C12 (runa vs runb)")
     assert "holds" in lines["C12"] and "fails" in lines["C12"] and lines["C12"].rstrip().endswith("*")
     assert main(["compare-claims", str(tmp_path / "nowhere"), str(tmp_path / "runb")]) == 2
     assert "no claims table" in capsys.readouterr().err

@@ -127,3 +127,19 @@ def compare_claims(a: pd.DataFrame, b: pd.DataFrame, names: tuple[str, str] = ("
     out["moved"] = np.where(out[f"{names[0]} {headline}"] == out[f"{names[1]} {headline}"], "", "*")
     return out
 
+
+def agreement_lines(a: pd.DataFrame, b: pd.DataFrame, names: tuple[str, str] = ("A", "B")) -> list[str]:
+    """How far two claims tables agree, one line per kind of verdict both have (the recipe's, the selected
+    seed's): on how many of the claims both list the verdict is the same, and the claims that hold in one and
+    fail in the other (what the stability run of docs/claims/results.md reports)."""
+    both = a.merge(b, on="claim", suffixes=("_a", "_b"))
+    lines = []
+    for column, what in (("recipe_verdict", "recipe verdicts"), ("verdict", "selected seeds' verdicts")):
+        if not (has_recipe(a) and has_recipe(b)) and column == "recipe_verdict":
+            continue
+        x, y = both[f"{column}_a"], both[f"{column}_b"]
+        flips = both.loc[((x == "holds") & (y == "fails")) | ((x == "fails") & (y == "holds")), "claim"].tolist()
+        lines.append(f"{what}: the same for {int((x == y).sum())} of {len(both)} claims; holds in one and fails in the "
+                     f"other: {', '.join(flips) if flips else 'none'} ({names[0]} vs {names[1]})")
+    return lines
+
