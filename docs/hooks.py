@@ -81,9 +81,15 @@ def config_reference() -> str:
 # --------------------------------------------------------------------- the tables reference
 
 
+def _codes(columns) -> str:
+    return ", ".join(f"`{c}`" for c in columns)
+
+
 def tables_reference() -> str:
     """Markdown: the columns of every rollout table (``efish schema``) and of the claims tables."""
     from efish.analysis.selection import RANKING_COLUMNS
+    from efish.claims.recipe import RECIPE_COLUMNS, RECIPE_PART_COLUMNS
+    from efish.claims.seeds import SEED_COLUMNS
     from efish.claims.verdicts import PART_COLUMNS, ROW_COLUMNS
     from efish.rollout.schema import COLUMNS, HIDDEN_UNITS
 
@@ -95,10 +101,16 @@ def tables_reference() -> str:
         if name == "hidden":
             out.append(f"| `h_0`, `h_1`, ... | `float` | {html.escape(HIDDEN_UNITS)} |")
         out.append("")
-    for title, anchor, columns in (("`claims.parquet`: one row per claim", "claims", ROW_COLUMNS),
-                                   ("`claim_parts.parquet`: one row per part of a claim", "claim-parts", PART_COLUMNS),
-                                   ("`ranking.parquet`: the seed ranking", "ranking", RANKING_COLUMNS)):
-        out += [f"## {title} {{#{anchor}}}", "", ", ".join(f"`{c}`" for c in columns), ""]
+    with_seeds = [*ROW_COLUMNS[:2], *RECIPE_COLUMNS, *ROW_COLUMNS[2:-1], *SEED_COLUMNS, ROW_COLUMNS[-1]]
+    claims_note = (f"The pipeline's table (with the top seeds' verdicts and the recipe's): {_codes(with_seeds)}. "
+                   "Meanings: [the claims page](../claims/index.md#what-a-row-holds).")
+    for title, anchor, columns, note in (
+            ("`claims.parquet`: one row per claim", "claims", ROW_COLUMNS, claims_note),
+            ("`claim_parts.parquet`: one row per part of a claim", "claim-parts", PART_COLUMNS, ""),
+            ("`recipe_parts.parquet`: one row per part, decided over the top seeds", "recipe-parts",
+             RECIPE_PART_COLUMNS, "How: [the recipe's verdict](../claims/index.md#the-recipes-verdict)."),
+            ("`ranking.parquet`: the seed ranking", "ranking", RANKING_COLUMNS, "")):
+        out += [f"## {title} {{#{anchor}}}", "", _codes(columns), ""] + ([note, ""] if note else [])
     return "\n".join(out)
 
 

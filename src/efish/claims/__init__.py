@@ -5,7 +5,7 @@ The files show the structure: :mod:`.verdicts` (the rules), :mod:`.statistics`
 claim is), :mod:`.parts` (the tests claims share), one module per figure
 (:mod:`.fig2` .. :mod:`.fig6`), :mod:`.registry` (the list of claims),
 :mod:`.table` (a run's claims table); and for reading them: :mod:`.seeds`
-(verdicts across the top seeds), :mod:`.stages` (along training),
+(each top seed's verdict), :mod:`.recipe` (the recipe's verdict over the seeds), :mod:`.stages` (along training),
 :mod:`.report` (markdown, two runs side by side).
 """
 
