@@ -134,19 +134,26 @@ def test_only_the_given_agents_states_are_decoded():
     assert (both["n"] == 40).all() and (homer["n"] == 20).all()
 
 
-def test_the_summary_is_the_mean_over_episodes_with_its_standard_error():
+def test_the_summary_pools_the_episodes_errors_so_that_a_constant_episode_does_not_swamp_it():
     rng = np.random.default_rng(3)
     x, groups = planted(rng, n_episodes=8, per=30, d=4)
-    hidden, steps = frames(x, groups, dist_agent_cm=x[:, 0] + 0.5 * rng.normal(size=len(x)))
+    dist = x[:, 0] + 0.5 * rng.normal(size=len(x))
+    eod = np.where(groups == 0, 0.0, (x[:, 1] > 1.5).astype(float))  # rare, and never in episode 0
+    hidden, steps = frames(x, groups, dist_agent_cm=dist, eod=eod)
     episodes = decode_episodes(hidden, steps)
     summary = summarise(episodes)
     assert list(summary.columns) == SUMMARY_COLUMNS and len(summary) == len(DECODE_TARGETS)
     row = summary.set_index("target").loc["dist_agent_cm"]
-    skill = episodes.loc[episodes["target"] == "dist_agent_cm", "skill"]
-    assert row["skill"] == pytest.approx(skill.mean()) and row["n_episodes"] == 8 and row["n"] == len(x)
-    assert row["skill_sem"] == pytest.approx(skill.std(ddof=1) / np.sqrt(8)) and row["reason"] == ""
-    lacking = summary.set_index("target").loc["eod"]
-    assert lacking["n_episodes"] == 0 and np.isnan(lacking["skill"]) and "lacks column 'eod'" in lacking["reason"]
+    mine = episodes[episodes["target"] == "dist_agent_cm"]
+    assert row["skill"] == pytest.approx(1 - mine["sse"].sum() / mine["sse_mean"].sum())
+    assert row["skill"] == pytest.approx(np.average(mine["skill"], weights=mine["sse_mean"]))
+    assert row["episode_skill_median"] == pytest.approx(mine["skill"].median())
+    assert row["n_episodes"] == 8 and row["n"] == len(x) and row["reason"] == "" and row["skill"] > 0.5
+    # an episode without a discharge sits near the training mean: its own skill is far below 0, the pooled one is not
+    silent = episodes.query("target == 'eod'").set_index("episode")["skill"]
+    assert silent[0] < -2 and summary.set_index("target").loc["eod", "skill"] > 0.1 > silent.mean()
+    lacking = summary.set_index("target").loc["turn_rad"]
+    assert lacking["n_episodes"] == 0 and np.isnan(lacking["skill"]) and "lacks column 'turn_rad'" in lacking["reason"]
 
 
 def test_food_decoding_splits_at_the_near_distance_and_scores_only_where_the_state_carries_food():

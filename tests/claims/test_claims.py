@@ -592,7 +592,7 @@ def test_c19_ignores_perfectly_decodable_input_copies_and_ranks_the_sensed_varia
     row = cl.CLAIMS["C19"].run(tables, CFG)
     assert row["verdict"] == "holds", row["reason"]
     assert "turn_rad" not in row["reason"] and "log_morm_sensed" not in row["reason"]
-    assert "mean skill: dist_agent_cm" in row["reason"]
+    assert "skill (Fig 6E): dist_agent_cm" in row["reason"]
 
 
 def test_decoding_claims_read_the_analysis_tables_and_say_what_they_lack():

@@ -4,11 +4,11 @@ and C19): the one decoder and the one list of decoded variables.
 :func:`heldout_skill` is the decoder: a linear readout fitted on whole
 episodes and scored on each held-out episode. :func:`decode_episodes` applies
 it to every target of :data:`DECODE_TARGETS` per condition (the dynamics
-table ``decoding_episodes``) and :func:`summarise` averages it over episodes
-(``decoding``, the bars of Fig 6D,E); :func:`food_decode_episodes` does the
-same on the steps with food near and far (``food_decoding_episodes`` and
-``food_decoding``, Fig 6F). The claims C18 and C19 read the per-episode
-tables, so a panel and a claim rest on the same numbers.
+table ``decoding_episodes``) and :func:`summarise` pools its errors over the
+episodes (``decoding``, the bars of Fig 6D,E); :func:`food_decode_episodes`
+does the same on the steps with food near and far (``food_decoding_episodes``
+and ``food_decoding``, Fig 6F). The claims C18 and C19 read these tables, so
+a panel and a claim rest on the same numbers.
 """
 
 from __future__ import annotations
@@ -41,12 +41,12 @@ DECODE_TARGETS = {**SENSED_TARGETS, **READOUT_TARGETS}
 FOOD_TARGETS = {c: SENSED_TARGETS[c] for c in ("dist_food_cm", "bearing_food_rad")}
 
 #: Columns of :func:`heldout_skill`: one row per held-out group (episode).
-SKILL_COLUMNS = ["episode", "n", "skill", "folds", "reason"]
+SKILL_COLUMNS = ["episode", "n", "sse", "sse_mean", "skill", "folds", "reason"]
 #: Columns of :func:`decode_episodes` (dynamics ``decoding_episodes``): one row per condition, target and episode.
-EPISODE_COLUMNS = ["condition", "target", "circular", "readout", "episode", "n", "skill", "folds", "reason"]
+EPISODE_COLUMNS = ["condition", "target", "circular", "readout", *SKILL_COLUMNS]
 #: Columns of :func:`summarise` (dynamics ``decoding``): one row per condition and target.
-SUMMARY_COLUMNS = ["condition", "target", "circular", "readout", "skill", "skill_sem", "n_episodes", "n", "folds",
-                   "reason"]
+SUMMARY_COLUMNS = ["condition", "target", "circular", "readout", "skill", "episode_skill_median", "n_episodes", "n",
+                   "folds", "reason"]
 
 
 def heldout_skill(x: np.ndarray, y: np.ndarray, groups: np.ndarray, circular: bool = False,
@@ -56,19 +56,21 @@ def heldout_skill(x: np.ndarray, y: np.ndarray, groups: np.ndarray, circular: bo
     The readout is OLS with an intercept (sklearn LinearRegression) fitted
     under GroupKFold(``folds``) over ``groups``: each group is held out whole,
     once, and predicted by the fit on the other folds. On each held-out group
-    ``g``, skill = 1 - sum_g |readout - y|^2 / sum_g |training mean - y|^2 with
-    that fold's training mean: 1 for a perfect readout, 0 for one no better than
-    the mean, below 0 for a worse one. A circular ``y`` (radians) is the unit
-    vector (cos y, sin y) and its squared error the squared chord between
-    the angles. Rows with a non-finite value are dropped.
+    ``g``, ``sse`` = sum_g |readout - y|^2, ``sse_mean`` = sum_g |training mean
+    - y|^2 with that fold's training mean, and skill = 1 - sse / sse_mean: 1
+    for a perfect readout, 0 for one no better than the mean, below 0 for a
+    worse one. A circular ``y`` (radians) is the unit vector (cos y, sin y)
+    and its squared error the squared chord between the angles. Rows with a
+    non-finite value are dropped.
 
-    Why this score (the claims' held-out skill, kept over the pooled
-    R^2 minus baseline R^2 that Fig 6 used before, the authors' score,
-    KempnerInstitute/wef analysis_rnn_decoding.py):
+    Why this score (the claims' held-out skill), kept over the R^2 minus
+    baseline R^2 that Fig 6 used before (pooled over the folds; the authors
+    average it over folds, KempnerInstitute/wef analysis_rnn_decoding.py):
 
     - one number per episode, so that two targets can be compared paired over
-      the unit of every claim test (docs/claims/index.md#rule-1), with a spread
-      and a count; a pooled score weighs a long episode more and has neither;
+      the unit of every claim test (docs/claims/index.md#rule-1); the errors
+      it is made of add up to the pooled skill a panel draws
+      (:func:`summarise`), where a pooled R^2 gives no number per episode;
     - its baseline is the same prediction R^2 - baseline R^2 subtracts, but
       it is in units of that baseline's error, so that 1 is a perfect readout
       whatever the held-out episodes' means (the difference of R^2s exceeds 1
@@ -102,8 +104,8 @@ def heldout_skill(x: np.ndarray, y: np.ndarray, groups: np.ndarray, circular: bo
     n_folds = min(folds, len(names))
 
     def undecodable(reason: str) -> pd.DataFrame:
-        return pd.DataFrame([{"episode": np.nan, "n": int(keep.sum()), "skill": np.nan, "folds": n_folds,
-                              "reason": reason}], columns=SKILL_COLUMNS)
+        return pd.DataFrame([{"episode": np.nan, "n": int(keep.sum()), "folds": n_folds, "reason": reason}],
+                            columns=SKILL_COLUMNS)
     if len(names) < 2:
         return undecodable(f"fewer than 2 groups (episodes) with finite rows ({len(names)})")
     if not np.any(np.ptp(target, axis=0) > 0):
@@ -116,8 +118,9 @@ def heldout_skill(x: np.ndarray, y: np.ndarray, groups: np.ndarray, circular: bo
         for g in np.unique(groups[test]):
             mine = groups[test] == g
             sse, sse0 = err[mine].sum(), base[mine].sum()
-            rows.append({"episode": g, "n": int(mine.sum()), "skill": 1.0 - sse / sse0 if sse0 > 0 else np.nan,
-                         "folds": n_folds, "reason": "" if sse0 > 0 else "the training mean predicts it exactly"})
+            rows.append({"episode": g, "n": int(mine.sum()), "sse": sse, "sse_mean": sse0,
+                         "skill": 1.0 - sse / sse0 if sse0 > 0 else np.nan, "folds": n_folds,
+                         "reason": "" if sse0 > 0 else "the training mean predicts it exactly"})
     return pd.DataFrame(rows, columns=SKILL_COLUMNS).sort_values("episode", kind="stable", ignore_index=True)
 
 
@@ -152,19 +155,27 @@ def decode_episodes(hidden: pd.DataFrame, steps: pd.DataFrame, targets: dict[str
 
 
 def summarise(episodes: pd.DataFrame, by: tuple[str, ...] = ()) -> pd.DataFrame:
-    """Per condition and target (and the ``by`` columns) of a per-episode decoding table: the mean ``skill`` over its
-    episodes, its standard error ``skill_sem`` (NaN under 2), ``n_episodes`` with a skill, ``n`` rows decoded,
-    ``folds`` and the first reason given (the dynamics table ``decoding``; columns ``by`` then :data:`SUMMARY_COLUMNS`).
+    """Per condition and target (and the ``by`` columns) of a per-episode decoding table (the dynamics table
+    ``decoding``; columns ``by`` then :data:`SUMMARY_COLUMNS`).
+
+    ``skill`` is the held-out skill over all the held-out episodes, 1 - sum
+    sse / sum sse_mean: the mean of the episodes' skills weighted by their
+    ``sse_mean``. Unweighted, an episode whose target sits at the training mean
+    all along (sse_mean near 0: an agent that never discharges) would give a
+    skill of -1000 and swamp the mean. ``episode_skill_median`` is the median
+    of the episodes' skills (what the claims' paired tests compare),
+    ``n_episodes`` the episodes with a skill, ``n`` the rows decoded,
+    ``folds`` and the first reason given.
     """
     keys = [*by, "condition", "target", "circular", "readout"]
     rows = []
     for values, sub in episodes.groupby(keys, sort=False, dropna=False):
-        skill = sub["skill"].to_numpy(np.float64)
-        skill = skill[np.isfinite(skill)]
+        scored = sub[np.isfinite(sub["skill"].to_numpy(np.float64))]
+        sse, sse_mean = scored["sse"].to_numpy(np.float64).sum(), scored["sse_mean"].to_numpy(np.float64).sum()
         reasons = [r for r in sub["reason"] if isinstance(r, str) and r]
-        rows.append({**dict(zip(keys, values, strict=True)), "skill": skill.mean() if skill.size else np.nan,
-                     "skill_sem": skill.std(ddof=1) / np.sqrt(skill.size) if skill.size > 1 else np.nan,
-                     "n_episodes": int(skill.size), "n": int(np.nansum(sub["n"].to_numpy(np.float64))),
+        rows.append({**dict(zip(keys, values, strict=True)), "skill": 1.0 - sse / sse_mean if len(scored) else np.nan,
+                     "episode_skill_median": scored["skill"].median() if len(scored) else np.nan,
+                     "n_episodes": len(scored), "n": int(np.nansum(sub["n"].to_numpy(np.float64))),
                      "folds": sub["folds"].max(), "reason": reasons[0] if reasons else ""})
     return pd.DataFrame(rows, columns=[*by, *SUMMARY_COLUMNS])
 

@@ -93,17 +93,17 @@ def c19(ctx: Context) -> list[Part]:
     near_cm = ctx.cfg.analysis.claims_food_near_cm
 
     def ranking() -> Outcome:
-        """The best agent feature against the best other sensed variable, ranked by Fig 6E's mean skill (dynamics
+        """The best agent feature against the best other sensed variable, ranked by Fig 6E's pooled skill (dynamics
         decoding), paired over the episodes of decoding_episodes."""
         summary = ctx.table(WIDE2_DECODING)
-        mean = summary[summary["target"].isin(list(SENSED_TARGETS))].groupby("target")["skill"].mean().dropna()
-        ours, rest = mean.reindex(AGENT_FEATURES).dropna(), mean.drop(list(AGENT_FEATURES), errors="ignore")
+        skill = summary[summary["target"].isin(list(SENSED_TARGETS))].groupby("target")["skill"].mean().dropna()
+        ours, rest = skill.reindex(AGENT_FEATURES).dropna(), skill.drop(list(AGENT_FEATURES), errors="ignore")
         if ours.empty or rest.empty:
             raise ValueError("no agent or no other sensed variable with a finite decoding skill")
         best, other = ours.idxmax(), rest.idxmax()
         out = paired_difference(ctx, decoded(ctx, WIDE2_DECODED, [best, other]), best, other)
-        ranked = ", ".join(f"{k} {v:.2f}" for k, v in mean.sort_values(ascending=False).items())
-        return dataclasses.replace(out, reason="; ".join(r for r in (out.reason, f"mean skill: {ranked}") if r))
+        ranked = ", ".join(f"{k} {v:.2f}" for k, v in skill.sort_values(ascending=False).items())
+        return dataclasses.replace(out, reason="; ".join(r for r in (out.reason, f"skill (Fig 6E): {ranked}") if r))
 
     def food() -> Outcome:
         """Per episode, the mean skill of the food variables near minus far (dynamics food_decoding_episodes)."""

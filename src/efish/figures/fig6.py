@@ -4,12 +4,13 @@
 Panels read the dynamics analysis (``analysis/dynamics/<assay>/``):
 ``dimensionality`` (D_eff, PCs for the variance fraction and wideband power
 per agent-episode), ``subsampling`` (D_eff of random unit subsets),
-``decoding`` (held-out decoding skill per target, mean over episodes), ``plsc`` (per distance
-bin), ``power_near_far`` and the statistic tables ``size_tests`` (D_eff
-against N) and ``power_tests`` (near vs far, smaller vs larger), whose stars
-the panels draw. Where the analysis does not yet write what a panel needs (the
-PCA variance spectrum, decoding split by food distance), the panel draws what
-there is and its caption, or the panel itself, says what is missing.
+``decoding`` and ``food_decoding`` (held-out decoding skill per target,
+pooled over episodes), ``plsc`` (per distance bin), ``power_near_far`` and
+the statistic tables ``size_tests`` (D_eff against N) and ``power_tests``
+(near vs far, smaller vs larger), whose stars the panels draw. Where the
+analysis does not yet write what a panel needs (the PCA variance spectrum),
+the panel draws what there is and its caption, or the panel itself, says what
+is missing.
 """
 
 from __future__ import annotations
@@ -62,7 +63,7 @@ READOUT_SUFFIX = " (readout)"
 READOUT_HATCH = "////"
 #: The decoding tables' column the bars draw (efish.analysis.decoding.summarise) and its axis label.
 SKILL = "skill"
-SKILL_LABEL = "held-out skill (1 - SSE / SSE of the mean)"
+SKILL_LABEL = "held-out decoding skill"
 POWER_LABEL = "wideband power (1/Hz)"
 
 
@@ -145,7 +146,7 @@ def readout_rows(decoding: pd.DataFrame) -> pd.Series:
 
 
 def decoding_bars(assay: str, title: str, control: str | None = None):
-    """A draw function: held-out decoding skill per target (mean over episodes, the dynamics decoding table), one
+    """A draw function: held-out decoding skill per target (pooled over episodes, the dynamics decoding table), one
     bar colour per condition (``control``, default the assay's first condition, grey).
 
     The sensed targets are ranked, best on top, as claim C19 ranks them; the
@@ -335,13 +336,13 @@ PANELS = [
     Panel("fig6", "D", decoding_bars("homing", "Homing: decoding", control="raycast"), {"decoding": _dyn("homing", "decoding")},
           "Linear decoding of step variables from the homer's hidden state, electric and ray-casting homing "
           "policies: held-out skill (1 - SSE of the readout / SSE of the training mean, on each episode held out "
-          "whole by 5-fold cross-validation), mean over episodes, analysis/dynamics/homing/decoding (per episode: "
+          "whole by analysis.decode_folds-fold cross-validation), pooled over episodes, analysis/dynamics/homing/decoding (per episode: "
           "decoding_episodes, which claim C18 tests); targets without a skill (e.g. no food in the arena) are left "
           "out. Readouts of the network's own input (its last turn and EOD, its size, its Knollenorgan inputs "
           "spiking, its largest Mormyromast input) are drawn hatched below the dashed line, not ranked."),
     Panel("fig6", "E", decoding_bars("wide2", "Two agents: decoding"), {"decoding": _dyn("wide2", "decoding")},
           "Held-out decoding skill per step variable from the hidden state of both agents of the wide2 assay "
-          "(160 x 40 cm), mean over episodes, analysis/dynamics/wide2/decoding. Each state is decoded against the "
+          "(160 x 40 cm), pooled over episodes, analysis/dynamics/wide2/decoding. Each state is decoded against the "
           "world it has observed (the step's observation it has taken in). The sensed variables are ranked best "
           "first, as claim C19 ranks them; the readouts of the network's own input (its last turn and EOD, its own "
           "size, its Knollenorgan inputs spiking and its largest Mormyromast input) are drawn hatched below the "
@@ -349,8 +350,8 @@ PANELS = [
     Panel("fig6", "F", food_decoding_bars, {"food_decoding": _dyn("wide2", "food_decoding")},
           "Held-out decoding skill of the food variables (distance and bearing of the nearest pellet) from the "
           "hidden states of the wide2 agents on the steps with that pellet within analysis.claims_food_near_cm "
-          "(near, in receptor range) and beyond it (far), mean over episodes; analysis/dynamics/wide2/food_decoding. "
-          "Claim C19 tests near > far on its episodes."),
+          "(near, in receptor range) and beyond it (far), pooled over episodes; "
+          "analysis/dynamics/wide2/food_decoding. Claim C19 tests near > far on its episodes."),
     Panel("fig6", "G", plsc_bars("s_1", "first PLSC singular value", "PLSC: first component"),
           {"plsc": _dyn("wide2", "plsc")},
           "Partial least squares correlation of the two wide2 agents' z-scored hidden states per pair-distance bin "
