@@ -12,7 +12,7 @@ import pytest
 from efish.analysis._tables import DEFAULTS
 from efish.analysis.decoding import (
     DECODE_TARGETS,
-    EPISODE_COLUMNS,
+    DECODED_COLUMNS,
     READOUT_TARGETS,
     SENSED_TARGETS,
     SKILL_COLUMNS,
@@ -114,7 +114,7 @@ def test_the_per_episode_table_has_its_columns_and_marks_readouts_and_missing_co
     hidden, steps = frames(x, groups, dist_agent_cm=x[:, 0] + 10, eod=(x[:, 1] > 0).astype(float),
                            turn_rad=x[:, 2])
     table = decode_episodes(hidden, steps)
-    assert list(table.columns) == EPISODE_COLUMNS
+    assert list(table.columns) == DECODED_COLUMNS
     assert set(table["target"]) == set(DECODE_TARGETS)
     marks = table.drop_duplicates("target").set_index("target")["readout"].to_dict()
     assert marks == {t: t in READOUT_TARGETS for t in DECODE_TARGETS}
@@ -167,7 +167,7 @@ def test_food_decoding_splits_at_the_near_distance_and_scores_only_where_the_sta
     x = np.c_[x, np.where(near, dist, 0.0), np.where(near, np.cos(bearing), 0), np.where(near, np.sin(bearing), 0)]
     hidden, steps = frames(x, groups, dist_food_cm=dist, bearing_food_rad=bearing)
     episodes = food_decode_episodes(hidden, steps, near_cm=10.0)
-    assert list(episodes.columns) == ["food", *EPISODE_COLUMNS]
+    assert list(episodes.columns) == ["food", *DECODED_COLUMNS]
     table = summarise(episodes, by=("food",)).set_index(["food", "target"])
     assert table.loc[("near", "dist_food_cm"), "skill"] > 0.9 and table.loc[("near", "bearing_food_rad"), "skill"] > 0.9
     assert abs(table.loc[("far", "dist_food_cm"), "skill"]) < 0.15
@@ -202,6 +202,9 @@ def test_the_dynamics_analysis_draws_the_mean_of_the_episodes_the_claims_test(as
     homer = 1 - cfg.env.homing_target if assay == "homing" else None
     expected = decode_episodes(tables["hidden"], tables["steps"], folds=cfg.analysis.decode_folds, agent=homer)
     pd.testing.assert_frame_equal(out["decoding_episodes"], expected)
+    food = food_decode_episodes(tables["hidden"], tables["steps"], cfg.analysis.claims_food_near_cm,
+                                cfg.analysis.decode_folds, homer)
+    pd.testing.assert_frame_equal(out["food_decoding_episodes"], food)
     rows = out["decoding_episodes"].query("target == 'dist_wall_cm'")
     steps = tables["steps"] if homer is None else tables["steps"].query("agent == @homer")
     assert rows["n"].sum() == len(steps)

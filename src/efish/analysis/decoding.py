@@ -43,7 +43,7 @@ FOOD_TARGETS = {c: SENSED_TARGETS[c] for c in ("dist_food_cm", "bearing_food_rad
 #: Columns of :func:`heldout_skill`: one row per held-out group (episode).
 SKILL_COLUMNS = ["episode", "n", "sse", "sse_mean", "skill", "folds", "reason"]
 #: Columns of :func:`decode_episodes` (dynamics ``decoding_episodes``): one row per condition, target and episode.
-EPISODE_COLUMNS = ["condition", "target", "circular", "readout", *SKILL_COLUMNS]
+DECODED_COLUMNS = ["condition", "target", "circular", "readout", *SKILL_COLUMNS]
 #: Columns of :func:`summarise` (dynamics ``decoding``): one row per condition and target.
 SUMMARY_COLUMNS = ["condition", "target", "circular", "readout", "skill", "episode_skill_median", "n_episodes", "n",
                    "folds", "reason"]
@@ -133,7 +133,7 @@ def decode_episodes(hidden: pd.DataFrame, steps: pd.DataFrame, targets: dict[str
     the homer of the homing assay) and an episode's rows, of every agent, are
     held out together. ``targets`` maps a steps column to whether it is
     circular (default :data:`DECODE_TARGETS`). One row per condition, target
-    and episode (columns :data:`EPISODE_COLUMNS`; ``readout`` True for the
+    and episode (columns :data:`DECODED_COLUMNS`; ``readout`` True for the
     targets of :data:`READOUT_TARGETS`); a target the steps table lacks, or one
     that cannot be decoded, is one row per condition with episode NaN and the reason.
     """
@@ -150,8 +150,8 @@ def decode_episodes(hidden: pd.DataFrame, steps: pd.DataFrame, targets: dict[str
             parts.append(skills.assign(condition=cond, target=target, circular=circular,
                                        readout=target in READOUT_TARGETS))
     if not parts:
-        return nan_frame("no hidden row matches a step").reindex(columns=EPISODE_COLUMNS)
-    return pd.concat(parts, ignore_index=True).reindex(columns=EPISODE_COLUMNS)
+        return nan_frame("no hidden row matches a step").reindex(columns=DECODED_COLUMNS)
+    return pd.concat(parts, ignore_index=True).reindex(columns=DECODED_COLUMNS)
 
 
 def summarise(episodes: pd.DataFrame, by: tuple[str, ...] = ()) -> pd.DataFrame:
@@ -161,8 +161,8 @@ def summarise(episodes: pd.DataFrame, by: tuple[str, ...] = ()) -> pd.DataFrame:
     ``skill`` is the held-out skill over all the held-out episodes, 1 - sum
     sse / sum sse_mean: the mean of the episodes' skills weighted by their
     ``sse_mean``. Unweighted, an episode whose target sits at the training mean
-    all along (sse_mean near 0: an agent that never discharges) would give a
-    skill of -1000 and swamp the mean. ``episode_skill_median`` is the median
+    all along (sse_mean near 0: an agent that never discharges) has a skill
+    far below -1 (-5,000 at the smoke scale) and would swamp the mean. ``episode_skill_median`` is the median
     of the episodes' skills (what the claims' paired tests compare),
     ``n_episodes`` the episodes with a skill, ``n`` the rows decoded,
     ``folds`` and the first reason given.
@@ -181,21 +181,22 @@ def summarise(episodes: pd.DataFrame, by: tuple[str, ...] = ()) -> pd.DataFrame:
 
 
 def food_decode_episodes(hidden: pd.DataFrame, steps: pd.DataFrame, near_cm: float = DEFAULTS.claims_food_near_cm,
-                         folds: int = DEFAULTS.decode_folds) -> pd.DataFrame:
+                         folds: int = DEFAULTS.decode_folds, agent: int | None = None) -> pd.DataFrame:
     """:func:`decode_episodes` of the food variables (:data:`FOOD_TARGETS`) on the steps with the nearest food within
     ``near_cm`` (``food`` = "near": in receptor range) and on those beyond it ("far"), per condition and episode
     (the dynamics table ``food_decoding_episodes``; Fig 6F, claim C19).
 
     ``near_cm``: ``analysis.claims_food_near_cm`` (the analysis passes the
     configured value; the default is its default, the authors' 5 cm
-    Mormyromast food range). Steps without food (NaN distance) are in neither.
-    Columns ``food`` then :data:`EPISODE_COLUMNS`; a range with fewer than 2
+    Mormyromast food range). Steps without food (NaN distance) are in neither;
+    ``agent`` as in :func:`decode_episodes`.
+    Columns ``food`` then :data:`DECODED_COLUMNS`; a range with fewer than 2
     episodes is one NaN row with the reason.
     """
-    columns = ["food", *EPISODE_COLUMNS]
+    columns = ["food", *DECODED_COLUMNS]
     if "dist_food_cm" not in steps.columns:
         return nan_frame("steps table lacks column 'dist_food_cm'").reindex(columns=columns)
     dist = steps["dist_food_cm"]
-    parts = [decode_episodes(hidden, steps[in_range], FOOD_TARGETS, folds).assign(food=food)
+    parts = [decode_episodes(hidden, steps[in_range], FOOD_TARGETS, folds, agent).assign(food=food)
              for food, in_range in (("near", dist <= near_cm), ("far", dist > near_cm))]
     return pd.concat(parts, ignore_index=True)[columns]

@@ -228,8 +228,9 @@ def _dynamics(t: Tables, cfg: EfishConfig) -> Tables:
     rng = np.random.default_rng(a.seed)
     dims = dynamics_table(hidden, a.variance_fraction, a.spectrogram_window, a.spectrogram_overlap, cfg.env.fps)
     control = control_condition(dims["condition"], cfg)
-    decoded = decode_episodes(hidden, steps, folds=a.decode_folds, agent=_homer(cfg))
-    food = food_decode_episodes(hidden, steps, a.claims_food_near_cm, a.decode_folds)
+    homer = _homer(cfg)
+    decoded = decode_episodes(hidden, steps, folds=a.decode_folds, agent=homer)
+    food = food_decode_episodes(hidden, steps, a.claims_food_near_cm, a.decode_folds, homer)
     return {"dimensionality": dims,
             "subsampling": subsample_table(hidden, a.subsample_fractions, a.subsample_draws, rng),
             "decoding": summarise(decoded), "decoding_episodes": decoded,
