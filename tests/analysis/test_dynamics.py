@@ -9,18 +9,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from efish.analysis._tables import DEFAULTS
 from efish.analysis.dynamics import (
-    DECODE_COLUMNS,
-    DECODE_TARGETS,
-    READOUT_TARGETS,
-    SENSED_TARGETS,
-    decode,
-    decode_table,
     degenerate_reason,
     dynamics_table,
     effective_dimensionality,
-    food_decode_table,
     hidden_matrix,
     pca_variances,
     pcs_for_variance,
@@ -30,7 +22,7 @@ from efish.analysis.dynamics import (
     wideband_power,
 )
 
-MODULES = ["signalling", "behaviour", "interactions", "homing", "stats", "dynamics"]
+MODULES = ["signalling", "behaviour", "interactions", "homing", "stats", "dynamics", "decoding"]
 
 
 def test_analysis_modules_load_neither_numba_nor_torch():
@@ -80,45 +72,6 @@ def test_subsample_units():
     full = out[out["fraction"] == 1.0]["d_eff"]
     assert full.to_numpy() == pytest.approx(np.full(4, effective_dimensionality(h)))
     assert out.equals(subsample_units(h, draws=4, rng=1))
-
-
-def planted(rng, n_episodes=12, per=50, d=20):
-    x = rng.normal(size=(n_episodes * per, d))
-    return x, np.repeat(np.arange(n_episodes), per)
-
-
-def test_decode_recovers_a_planted_readout():
-    rng = np.random.default_rng(0)
-    x, groups = planted(rng)
-    out = decode(x, x @ rng.normal(size=20) + 0.01 * rng.normal(size=len(x)), groups)
-    assert out["score"] == pytest.approx(1.0, abs=0.05) and out["r2"] > 0.99 and out["folds"] == 5
-    angle = np.arctan2(x[:, 1], x[:, 0])  # a circular target; its cos and sin are not linear in x,
-    circ = decode(np.c_[x, np.cos(angle), np.sin(angle)], angle, groups, circular=True)  # unless given
-    assert circ["score"] == pytest.approx(1.0, abs=0.05)
-
-
-def test_decode_is_about_zero_on_noise_and_on_unrelated_episode_constants():
-    rng = np.random.default_rng(0)
-    x, groups = planted(rng)
-    noise = decode(x, rng.normal(size=len(x)), groups)
-    episode_constant = decode(x, rng.normal(size=12)[groups], groups)  # leaks only if folds split episodes
-    assert abs(noise["score"]) < 0.15 and abs(episode_constant["score"]) < 0.15
-
-
-def test_decode_degenerate_inputs():
-    rng = np.random.default_rng(0)
-    x, groups = planted(rng, n_episodes=3)
-    one = decode(x, x[:, 0], np.zeros(len(x)))
-    assert np.isnan(one["score"]) and one["reason"].startswith("fewer than 2 groups")
-    assert decode(x, np.ones(len(x)), groups)["reason"] == "constant target"
-    nan_y = x[:, 0].copy()
-    nan_y[:10] = np.nan
-    out = decode(x, nan_y, groups)
-    assert out["n"] == len(x) - 10 and out["folds"] == 3 and out["score"] > 0.9
-    all_nan = decode(np.c_[x, np.full(len(x), np.nan)], x[:, 0], groups)
-    assert np.isnan(all_nan["score"]) and all_nan["n"] == 0 and all_nan["reason"] != ""
-    with pytest.raises(ValueError, match="differ in length"):
-        decode(x, x[:-1, 0], groups)
 
 
 def test_plsc_finds_planted_shared_dimensions():
@@ -179,64 +132,3 @@ def test_plsc_by_distance_finds_sharing_only_where_planted():
     assert out["hi_cm"].tolist() == [10.0, 100.0, np.inf] and (out["reason"] == "").all()
     sparse = plsc_by_distance(h_a[:20], h_b[:20], np.full(20, 500.0), rng=0)
     assert sparse.loc[0, "reason"].startswith("need a T x D") and np.isnan(sparse.loc[0, "n_significant"])
-
-
-def test_food_decoding_splits_at_the_near_distance_and_scores_only_where_the_state_carries_food():
-    rng = np.random.default_rng(0)
-    x, groups = planted(rng, n_episodes=10, per=80)
-    dist = np.where(np.arange(len(x)) % 2 == 0, rng.uniform(0, 10, len(x)), rng.uniform(20, 100, len(x)))
-    dist[::7] = np.nan  # steps without food are in neither range
-    near = dist <= 10
-    # the hidden state carries the food distance (and bearing) only when food is near
-    bearing = rng.uniform(-np.pi, np.pi, len(x))
-    x = np.c_[x, np.where(near, dist, 0.0), np.where(near, np.cos(bearing), 0), np.where(near, np.sin(bearing), 0)]
-    hidden = pd.DataFrame(x, columns=[f"h_{i}" for i in range(x.shape[1])]).assign(
-        condition="control", episode=groups, agent=0, t=np.tile(np.arange(80), 10))
-    steps = hidden[["condition", "episode", "agent", "t"]].assign(dist_food_cm=dist, bearing_food_rad=bearing)
-    table = food_decode_table(hidden, steps, near_cm=10.0).set_index(["food", "target"])
-    assert table.loc[("near", "dist_food_cm"), "score"] > 0.9 and table.loc[("near", "bearing_food_rad"), "score"] > 0.9
-    assert abs(table.loc[("far", "dist_food_cm"), "score"]) < 0.15
-    assert abs(table.loc[("far", "bearing_food_rad"), "score"]) < 0.15
-    assert table.loc[("near", "dist_food_cm"), "n"] == np.sum(near)
-    assert table.loc[("far", "dist_food_cm"), "n"] == np.sum(dist > 10)
-    lacking = food_decode_table(hidden, steps.drop(columns="dist_food_cm"), near_cm=10.0)
-    assert lacking["reason"].iloc[0] == "steps table lacks column 'dist_food_cm'"
-
-
-def test_sensed_and_readout_targets_split_the_decoded_columns():
-    """Decoding rule: the policy's own outputs and size are readouts, never sensed competitors (claim C19)."""
-    assert set(SENSED_TARGETS).isdisjoint(READOUT_TARGETS)
-    assert DECODE_TARGETS == {**SENSED_TARGETS, **READOUT_TARGETS}
-    assert set(READOUT_TARGETS) == {"turn_rad", "eod", "size"}
-    fig_6e = {"dist_agent_cm", "n_agents_100cm", "log_morm_sensed", "dist_wall_cm"}
-    assert fig_6e <= set(SENSED_TARGETS) and not SENSED_TARGETS["dist_agent_cm"]
-    # the bearings are circular; the realised turn is a small signed change, decoded as a number
-    assert all(DECODE_TARGETS[c] == c.startswith("bearing_") for c in DECODE_TARGETS)
-
-
-def test_the_decoding_table_marks_the_readouts():
-    rng = np.random.default_rng(0)
-    x, groups = planted(rng, n_episodes=6, per=40, d=4)
-    hidden = pd.DataFrame(x, columns=[f"h_{i}" for i in range(4)]).assign(
-        condition="control", episode=groups, agent=0, t=np.tile(np.arange(40), 6))
-    steps = hidden[["condition", "episode", "agent", "t"]].assign(
-        dist_agent_cm=x[:, 0] + 10, eod=(x[:, 1] > 0).astype(float), turn_rad=x[:, 2])
-    whole = decode_table(hidden, steps)
-    assert list(whole.columns) == DECODE_COLUMNS and len(whole) == len(DECODE_TARGETS)
-    table = whole.set_index("target")
-    assert table["readout"].to_dict() == {t: t in READOUT_TARGETS for t in DECODE_TARGETS}
-    assert table.loc["dist_agent_cm", "score"] > 0.9 and table.loc["turn_rad", "score"] > 0.9
-    assert table.loc["log_morm_sensed", "reason"] == "steps table lacks column 'log_morm_sensed'"
-
-
-def test_food_is_near_within_the_configured_5_cm_by_default():
-    assert DEFAULTS.claims_food_near_cm == 5.0  # the authors' Mormyromast food range
-    rng = np.random.default_rng(0)
-    x, groups = planted(rng, n_episodes=6, per=40, d=3)
-    dist = np.tile(np.linspace(0.0, 12.0, 40), 6)
-    hidden = pd.DataFrame(x, columns=[f"h_{i}" for i in range(3)]).assign(
-        condition="control", episode=groups, agent=0, t=np.tile(np.arange(40), 6))
-    steps = hidden[["condition", "episode", "agent", "t"]].assign(dist_food_cm=dist, bearing_food_rad=x[:, 0])
-    table = food_decode_table(hidden, steps).set_index(["food", "target"])
-    assert table.loc[("near", "dist_food_cm"), "n"] == np.sum(dist <= 5.0)
-    assert table.loc[("far", "dist_food_cm"), "n"] == np.sum(dist > 5.0)

@@ -18,6 +18,7 @@ from efish.analysis.behaviour import (
     food_vs_size,
     theil_per_episode,
 )
+from efish.analysis.decoding import decode_episodes, food_decode_episodes, summarise
 from efish.analysis.dynamics_tests import power_near_far, power_tests, size_tests
 from efish.analysis.interactions import size_role_tests
 from efish.analysis.onepatch import reach_tests
@@ -334,13 +335,27 @@ def hidden_of(steps: pd.DataFrame, columns: dict[str, np.ndarray], units: int = 
     return steps[["condition", "episode", "agent", "t"]].assign(**h)
 
 
-def c18(flip):
+def decoding_tables(assay: str, hidden: pd.DataFrame, steps: pd.DataFrame, agent: int | None = None) -> dict:
+    """The dynamics analysis's decoding tables of ``assay`` (per episode and their means, also of food near and far),
+    computed as the analysis computes them."""
+    folds, near = CFG.analysis.decode_folds, CFG.analysis.claims_food_near_cm
+    episodes = decode_episodes(hidden, steps, folds=folds, agent=agent)
+    food = food_decode_episodes(hidden, steps, near, folds)
+    return {A("dynamics", assay, "decoding"): summarise(episodes), A("dynamics", assay, "decoding_episodes"): episodes,
+            A("dynamics", assay, "food_decoding"): summarise(food, by=("food",)),
+            A("dynamics", assay, "food_decoding_episodes"): food}
+
+
+def c18(flip, coded: str | None = None, seed: int = 18):
+    """The homer's states carry the Knollenorgan error angle (``flip``: the bearing to the target; ``coded`` =
+    "none": neither) as cos and sin with noise."""
     steps = homing_steps(False)
-    rng = np.random.default_rng(18)
-    coded = steps["bearing_agent_rad" if flip else "err_knollen_rad"].to_numpy()
+    rng = np.random.default_rng(seed)
+    coded = coded or ("bearing_agent_rad" if flip else "err_knollen_rad")
+    angle = steps[coded].to_numpy() if coded != "none" else rng.uniform(-np.pi, np.pi, len(steps))
     noise = rng.normal(0, 0.05, (2, len(steps)))
-    return {R("homing", "steps"): steps,
-            R("homing", "hidden"): hidden_of(steps, {"h_0": np.cos(coded) + noise[0], "h_1": np.sin(coded) + noise[1]})}
+    hidden = hidden_of(steps, {"h_0": np.cos(angle) + noise[0], "h_1": np.sin(angle) + noise[1]}, seed=seed)
+    return decoding_tables("homing", hidden, steps, agent=1)
 
 
 def wide_pair(flip: bool, episodes: int = 10, steps: int = 240) -> dict:
@@ -383,7 +398,8 @@ def wide_pair(flip: bool, episodes: int = 10, steps: int = 240) -> dict:
 
 
 def c19(flip):
-    return wide_pair(flip)
+    tables = wide_pair(flip)
+    return decoding_tables("wide2", tables[R("wide2", "hidden")], tables[R("wide2", "steps")])
 
 
 def c20(flip):
@@ -564,13 +580,70 @@ def test_c13_holds_on_a_sweep_where_intake_and_inequality_fall_with_the_patch_co
         assert part in row["reason"]
 
 
-def test_c19_ignores_a_perfectly_decodable_turn_and_ranks_the_sensed_variables():
-    """The policy's own turn is decoded perfectly (a readout, rule 7): it is no competitor, and the nearest-agent
-    distance, the best sensed variable, makes the claim hold."""
-    tables = c19(False)
+def test_c19_ignores_perfectly_decodable_input_copies_and_ranks_the_sensed_variables():
+    """The policy's own turn and its largest Mormyromast input are decoded perfectly (copies of its input, rule 7):
+    they are no competitors, and the nearest-agent distance, the best sensed variable, makes the claim hold."""
+    pair = wide_pair(False)
+    steps = pair[R("wide2", "steps")]
+    hidden = pair[R("wide2", "hidden")].assign(h_8=steps["log_morm_sensed"].to_numpy())
+    tables = decoding_tables("wide2", hidden, steps)
+    readouts = tables[A("dynamics", "wide2", "decoding")].set_index("target")
+    assert readouts.loc["turn_rad", "skill"] > 0.9 and readouts.loc["log_morm_sensed", "skill"] > 0.9
     row = cl.CLAIMS["C19"].run(tables, CFG)
     assert row["verdict"] == "holds", row["reason"]
-    assert "turn_rad" not in row["reason"] and "mean skill: dist_agent_cm" in row["reason"]
+    assert "turn_rad" not in row["reason"] and "log_morm_sensed" not in row["reason"]
+    assert "skill (Fig 6E): dist_agent_cm" in row["reason"]
+
+
+def test_decoding_claims_read_the_analysis_tables_and_say_what_they_lack():
+    """C18 and C19 select rows of the dynamics decoding tables: a target the analysis could not decode is a not-run
+    part with the analysis's reason."""
+    tables = c18(False)
+    episodes = tables[A("dynamics", "homing", "decoding_episodes")]
+    lacking = episodes[episodes["target"] != "err_knollen_rad"]
+    lacking = pd.concat([lacking, pd.DataFrame([{"condition": "electric", "target": "err_knollen_rad",
+                                                  "episode": np.nan, "skill": np.nan,
+                                                  "reason": "steps table lacks column 'err_knollen_rad'"}])])
+    row = cl.CLAIMS["C18"].run({A("dynamics", "homing", "decoding_episodes"): lacking}, CFG)
+    assert row["verdict"] == "not run" and "lacks column 'err_knollen_rad'" in row["reason"], row["reason"]
+    assert set(cl.CLAIMS["C18"].tables) == {A("dynamics", "homing", "decoding_episodes")}
+    assert all(t.startswith("analysis/dynamics/wide2/") for t in cl.CLAIMS["C19"].tables)
+
+
+def test_decoding_parts_without_a_planted_effect_reject_at_about_the_nominal_rate():
+    """The third arm beside the paper's sign and the opposite one: C18 with neither angle in the state, C19's food
+    part with food coded alike near and far. Each holds or fails (p < 0.05 either way) in about 5% of 20 planted
+    datasets; at most 4 of 20 (binomial tail 1.6% at a true 5%)."""
+    decided = {"C18": 0, "C19": 0}
+    for seed in range(20):
+        part = cl.CLAIMS["C18"].assess(c18(False, coded="none", seed=100 + seed), CFG)[1][0]
+        assert part.n == 12 and part.verdict in ("holds", "weaker", "fails"), part.reason
+        decided["C18"] += part.verdict in ("holds", "fails")
+        food = next(p for p in cl.CLAIMS["C19"].assess(food_alike(seed), CFG)[1] if p.label == "food near > far")
+        assert food.n == 10 and food.verdict in ("holds", "weaker", "fails"), food.reason
+        decided["C19"] += food.verdict in ("holds", "fails")
+    assert all(k <= 4 for k in decided.values()), decided
+
+
+def food_alike(seed: int) -> dict:
+    """wide2 states that carry the food distance and bearing with the same noise whether the pellet is near or far."""
+    rng = np.random.default_rng(300 + seed)
+    steps = []
+    for e in range(10):
+        for a in range(2):
+            n = 120
+            steps.append(pd.DataFrame({"condition": "control", "episode": e, "agent": a, "t": np.arange(n),
+                                       "dist_food_cm": np.r_[rng.uniform(0, 5, n // 2), rng.uniform(5, 30, n // 2)],
+                                       "bearing_food_rad": rng.uniform(-np.pi, np.pi, n)}))
+    steps = pd.concat(steps, ignore_index=True)
+    dist, bearing = steps["dist_food_cm"].to_numpy(), steps["bearing_food_rad"].to_numpy()
+    # each variable standardised within its range, so that near and far carry it equally
+    near = dist <= CFG.analysis.claims_food_near_cm
+    scaled = np.where(near, (dist - 2.5) / 1.44, (dist - 17.5) / 7.2)
+    noise = rng.normal(0, 1.0, (3, len(steps)))
+    hidden = hidden_of(steps, {"h_0": scaled + noise[0], "h_1": np.cos(bearing) + noise[1] / 1.4,
+                               "h_2": np.sin(bearing) + noise[2] / 1.4}, seed=seed)
+    return decoding_tables("wide2", hidden, steps)
 
 
 def test_bootstrap_reruns_are_identical_and_the_seed_matters():

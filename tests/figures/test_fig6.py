@@ -32,48 +32,52 @@ def test_every_panel_renders_with_labelled_axes(key, synthetic_results, tmp_path
     assert said_missing or (ax.get_xlabel() and ax.get_ylabel()), key
 
 
-def test_decoding_bars_are_the_scores_best_first_without_unscored_targets(recorded):
-    table = pd.DataFrame({"condition": "control", "target": ["log_morm_sensed", "dist_agent_cm", "size", "dist_food_cm"],
-                          "score": [0.2, 0.6, np.nan, -0.1], "reason": ["", "", "constant target", ""]})
+def test_decoding_bars_are_the_skills_best_first_without_unscored_targets(recorded):
+    table = pd.DataFrame({"condition": "control", "target": ["dist_wall_cm", "dist_agent_cm", "size", "dist_food_cm"],
+                          "skill": [0.2, 0.6, np.nan, -0.1], "reason": ["", "", "constant target", ""]})
     ax = draw("fig6/E", {"decoding": table, **recorded("wide2")})
     widths = [p.get_width() for p in ax.patches if p.get_height() > 0]
     np.testing.assert_allclose(widths, [0.6, 0.2, -0.1])
-    assert [t.get_text() for t in ax.get_yticklabels()] == ["nearest agent: distance", "log reading (M, sensed)",
+    assert [t.get_text() for t in ax.get_yticklabels()] == ["nearest agent: distance", "wall: distance",
                                                             "food: distance"]
 
 
 @pytest.mark.parametrize("with_column", [True, False])
 def test_readouts_are_drawn_hatched_below_the_sensed_targets_and_not_ranked_among_them(with_column, recorded):
-    """Decoding rule: the own turn, EOD and size are drawn as readouts, after every sensed target, even when
-    they score best; a table without the readout column (an earlier run) is marked by target."""
-    table = pd.DataFrame({"condition": "control", "target": ["turn_rad", "dist_agent_cm", "eod", "dist_wall_cm"],
-                          "readout": [True, False, True, False], "score": [0.8, 0.3, 0.6, 0.1], "reason": ""})
+    """Decoding rule: the copies of the network's input (own turn, EOD and size, its sensor summaries) are drawn as
+    readouts, after every sensed target, even when they decode best; a table without the readout column (an
+    earlier run) is marked by target."""
+    table = pd.DataFrame({"condition": "control",
+                          "target": ["turn_rad", "dist_agent_cm", "eod", "dist_wall_cm", "log_morm_sensed"],
+                          "readout": [True, False, True, False, True], "skill": [0.8, 0.3, 0.6, 0.1, 0.5],
+                          "reason": ""})
     ax = draw("fig6/E", {"decoding": table if with_column else table.drop(columns="readout"), **recorded("wide2")})
     bars = [p for p in ax.patches if p.get_height() > 0]
-    np.testing.assert_allclose([p.get_width() for p in bars], [0.3, 0.1, 0.8, 0.6])
+    np.testing.assert_allclose([p.get_width() for p in bars], [0.3, 0.1, 0.8, 0.6, 0.5])
     assert [t.get_text() for t in ax.get_yticklabels()] == ["nearest agent: distance", "wall: distance",
-                                                            "turn (readout)", "own EOD (readout)"]
-    assert [bool(p.get_hatch()) for p in bars] == [False, False, True, True]
+                                                            "turn (readout)", "own EOD (readout)",
+                                                            "log reading (M, sensed) (readout)"]
+    assert [bool(p.get_hatch()) for p in bars] == [False, False, True, True, True]
     assert any(line.get_linestyle() == "--" for line in ax.get_lines())  # the line between the two groups
 
 
-def test_decoding_without_any_score_says_why(recorded):
-    table = pd.DataFrame({"condition": ["electric"], "target": ["size"], "score": [np.nan],
+def test_decoding_without_any_skill_says_why(recorded):
+    table = pd.DataFrame({"condition": ["electric"], "target": ["size"], "skill": [np.nan],
                           "reason": ["constant target"]})
     ax = draw("fig6/D", {"decoding": table, **recorded("homing")})
     assert any("constant target" in t for t in texts(ax))
 
 
-def test_food_decoding_bars_pair_near_and_far_scores_per_variable(recorded):
+def test_food_decoding_bars_pair_near_and_far_skills_per_variable(recorded):
     table = pd.DataFrame({"condition": "control", "food": ["near", "near", "far", "far"],
-                          "target": ["dist_food_cm", "bearing_food_rad"] * 2, "score": [0.5, 0.3, -0.05, np.nan],
+                          "target": ["dist_food_cm", "bearing_food_rad"] * 2, "skill": [0.5, 0.3, -0.05, np.nan],
                           "reason": ["", "", "", "fewer than 2 groups (episodes) with finite rows (1)"]})
     ax = draw("fig6/F", {"food_decoding": table, **recorded("wide2")})
     widths = sorted(p.get_width() for p in ax.patches if p.get_height() > 0 and np.isfinite(p.get_width()))
     np.testing.assert_allclose(widths, [-0.05, 0.3, 0.5])
     assert {t.get_text() for t in ax.get_yticklabels()} == {"food: distance", "food: bearing"}
     assert [t.get_text() for t in ax.get_legend().get_texts()] == ["near", "far"]
-    empty = draw("fig6/F", {"food_decoding": table.assign(score=np.nan), **recorded("wide2")})
+    empty = draw("fig6/F", {"food_decoding": table.assign(skill=np.nan), **recorded("wide2")})
     assert any("fewer than 2 groups" in t for t in texts(empty))
 
 
@@ -153,6 +157,6 @@ def test_thresholds_named_on_the_panels_are_the_runs(recorded):
     ax = draw("fig6/I", {"power": power, "tests": pd.DataFrame({"measure": ["near_far"], "stars": ["*"]}), **wide2})
     assert [t.get_text() for t in ax.get_xticklabels()] == ["near (<= 7 cm)", "far (> 45 cm)"]
     table = pd.DataFrame({"condition": "control", "food": ["near", "far"], "target": "dist_food_cm",
-                          "score": [0.5, 0.1], "reason": ""})
+                          "skill": [0.5, 0.1], "reason": ""})
     ax = draw("fig6/F", {"food_decoding": table, **wide2})
     assert ax.get_legend().get_title().get_text() == "food (near: <= 3 cm)"

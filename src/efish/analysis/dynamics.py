@@ -1,5 +1,5 @@
-"""Hidden-state dynamics (docs/methods/analyses.md#analysis-dynamics; Fig 6): dimensionality, decoding, shared
-dimensions (PLSC), power.
+"""Hidden-state dynamics (docs/methods/analyses.md#analysis-dynamics; Fig 6): dimensionality, shared dimensions
+(PLSC), power; decoding is :mod:`efish.analysis.decoding`.
 
 Functions on matrices take a T x D array ``h`` (time x units, e.g. one
 agent-episode of the ``hidden`` table, see :func:`hidden_matrix`). Scalar
@@ -14,34 +14,11 @@ import itertools
 import numpy as np
 import pandas as pd
 from scipy import signal
-from sklearn.dummy import DummyRegressor
-from sklearn.linear_model import LinearRegression
-from sklearn.metrics import r2_score
-from sklearn.model_selection import GroupKFold, cross_val_predict
 
 from ._tables import AGENT_EPISODE, DEFAULTS, EPISODE, RATE_HZ, nan_frame, require
 from .plsc_tests import plsc_collapse, shared_dimensions
 
 SUBSAMPLE_FRACTIONS = tuple(DEFAULTS.subsample_fractions)
-#: Steps columns of the world the hidden state has observed (docs/reference/tables.md; Fig 6E's sensed
-#: variables, docs/methods/analyses.md#decoding-variables) -> circular (radians) or not: the only competitors when
-#: decoding scores are ranked (claim C19). Each describes the world after step t, which the hidden row t has taken in
-#: (efish.rollout.run.hidden_table).
-SENSED_TARGETS = {"dist_agent_cm": False, "n_agents_100cm": False, "log_morm_sensed": False, "dist_wall_cm": False,
-                  "bearing_agent_rad": True, "dist_agent2_cm": False, "size_agent1": False, "size_agent2": False,
-                  "dist_food_cm": False, "bearing_food_rad": True, "bearing_wall_rad": True,
-                  "food_count_5cm": False, "log_amp_field": False}
-#: Steps columns that are readouts of the policy itself, not sensing (docs/claims/index.md#rule-7): its own outputs of
-#: step t (the realised turn, the EOD: produced by the state before row t's, and fed back to row t's state through the
-#: observation's last-action tail) and the agent's own size, a per-agent constant of every observation. Decoded and
-#: reported, never ranked among the sensed targets.
-READOUT_TARGETS = {"turn_rad": False, "eod": False, "size": False}
-#: Every decoded steps column -> circular: the sensed targets, then the readouts. A column the steps table lacks
-#: gets a row with a reason. Kept as the union so that the decoding table has a row for each.
-DECODE_TARGETS = {**SENSED_TARGETS, **READOUT_TARGETS}
-#: ``readout``: the row's target is in :data:`READOUT_TARGETS` (drawn and reported apart from the sensed ones).
-DECODE_COLUMNS = ["condition", "target", "circular", "readout", "r2", "baseline_r2", "score", "n", "n_groups", "folds",
-                  "reason"]
 
 
 def units(hidden: pd.DataFrame) -> list[str]:
@@ -149,42 +126,6 @@ def dynamics_table(hidden: pd.DataFrame, fraction: float = DEFAULTS.variance_fra
                      "wideband_power": wideband_power(h, window, overlap, fs), "reason": degenerate_reason(h)})
     return pd.DataFrame(rows, columns=[*AGENT_EPISODE, "n_steps", "d_eff", "pcs_for_variance", "wideband_power",
                                        "reason"])
-
-
-def decode(x: np.ndarray, y: np.ndarray, groups: np.ndarray, circular: bool = False,
-           folds: int = DEFAULTS.decode_folds) -> dict:
-    """Cross-validated linear readout of ``y`` from ``x``, folds grouped by episode
-    (docs/methods/analyses.md#analysis-dynamics).
-
-    OLS (sklearn LinearRegression) under GroupKFold(``folds``) over ``groups``
-    (so no episode is in both train and test), pooled out-of-fold predictions;
-    ``r2`` is their R^2, ``baseline_r2`` that of predicting each test fold with
-    its training mean (DummyRegressor), ``score`` = r2 - baseline_r2. A
-    circular ``y`` (radians) is decoded as (cos y, sin y) and R^2 averaged over
-    both. Rows with a non-finite value are dropped (``n`` counts the rest);
-    fewer than 2 groups or a constant target give NaN with a reason.
-    """
-    x = np.asarray(x, dtype=np.float64)
-    x = x[:, None] if x.ndim == 1 else x
-    y, groups = np.asarray(y, dtype=np.float64), np.asarray(groups)
-    if not len(x) == len(y) == len(groups):
-        raise ValueError(f"x, y and groups differ in length: {len(x)}, {len(y)}, {len(groups)}")
-    target = np.column_stack([np.cos(y), np.sin(y)]) if circular else y[:, None]
-    keep = np.all(np.isfinite(x), axis=1) & np.all(np.isfinite(target), axis=1)
-    x, target, groups = x[keep], target[keep], groups[keep]
-    n_groups = len(np.unique(groups))
-    out = {"r2": np.nan, "baseline_r2": np.nan, "score": np.nan, "n": int(keep.sum()), "n_groups": n_groups,
-           "folds": min(folds, n_groups), "reason": ""}
-    if n_groups < 2:
-        return {**out, "reason": f"fewer than 2 groups (episodes) with finite rows ({n_groups})"}
-    if not np.any(np.ptp(target, axis=0) > 0):
-        return {**out, "reason": "constant target"}
-    cv = GroupKFold(n_splits=out["folds"])
-    pred = cross_val_predict(LinearRegression(), x, target, groups=groups, cv=cv).reshape(target.shape)
-    base = cross_val_predict(DummyRegressor(strategy="mean"), x, target, groups=groups, cv=cv).reshape(target.shape)
-    varies = np.ptp(target, axis=0) > 0  # a circular target fixed in cos or sin has no R^2 in that component
-    r2, r2_base = r2_score(target[:, varies], pred[:, varies]), r2_score(target[:, varies], base[:, varies])
-    return {**out, "r2": float(r2), "baseline_r2": float(r2_base), "score": float(r2 - r2_base)}
 
 
 def _zscore(h: np.ndarray) -> np.ndarray:
@@ -305,58 +246,6 @@ def _with_steps(hidden: pd.DataFrame, steps: pd.DataFrame, columns: list[str]) -
     require(hidden, keys, "hidden table")
     require(steps, [*keys, *columns], "steps table")
     return hidden.merge(steps[[*keys, *columns]], on=keys).sort_values(keys, kind="stable")
-
-
-def decode_table(hidden: pd.DataFrame, steps: pd.DataFrame, targets: dict[str, bool] | None = None,
-                 folds: int = DEFAULTS.decode_folds) -> pd.DataFrame:
-    """:func:`decode` of every target column of ``steps`` from the hidden state, per condition (Fig 6D-F).
-
-    All agents of a condition are pooled and folds are grouped by episode.
-    ``targets`` maps a steps column to whether it is circular (default
-    :data:`DECODE_TARGETS`). One row per condition and target (columns
-    :data:`DECODE_COLUMNS`, ``readout`` True for the targets of
-    :data:`READOUT_TARGETS`); a target the steps table lacks is NaN with a reason.
-    """
-    targets = DECODE_TARGETS if targets is None else targets
-    present = [c for c in targets if c in steps.columns]
-    joined = _with_steps(hidden, steps, present)
-    h, rows = units(hidden), []
-    for cond, sub in joined.groupby("condition", sort=True):
-        x = sub[h].to_numpy(np.float64)
-        for target, circular in targets.items():
-            res = (decode(x, sub[target].to_numpy(np.float64), sub["episode"].to_numpy(), circular, folds)
-                   if target in present else {"reason": f"steps table lacks column {target!r}"})
-            rows.append({"condition": cond, "target": target, "circular": circular,
-                         "readout": target in READOUT_TARGETS, **res})
-    if not rows:
-        return nan_frame("no hidden row matches a step").reindex(columns=DECODE_COLUMNS)
-    return pd.DataFrame(rows, columns=DECODE_COLUMNS)
-
-
-#: The food variables decoded separately with food near and far (Fig 6F, claim C19) -> circular or not.
-FOOD_TARGETS = {"dist_food_cm": False, "bearing_food_rad": True}
-FOOD_DECODE_COLUMNS = ["condition", "food", *DECODE_COLUMNS[1:]]
-
-
-def food_decode_table(hidden: pd.DataFrame, steps: pd.DataFrame, near_cm: float = DEFAULTS.claims_food_near_cm,
-                      folds: int = DEFAULTS.decode_folds) -> pd.DataFrame:
-    """:func:`decode_table` of the food variables on the steps with the nearest food within ``near_cm`` (``food``
-    = "near": in receptor range) and on those beyond it ("far"), per condition (Fig 6F, claim C19).
-
-    ``near_cm``: ``analysis.claims_food_near_cm`` (the analysis passes the
-    configured value; the default is its default, the authors' 5 cm
-    Mormyromast food range).
-
-    Steps without food (NaN distance) are in neither. One row per range,
-    condition and food target (columns :data:`FOOD_DECODE_COLUMNS`); a range
-    with fewer than 2 episodes is NaN with the reason :func:`decode` gives.
-    """
-    if "dist_food_cm" not in steps.columns:
-        return nan_frame("steps table lacks column 'dist_food_cm'").reindex(columns=FOOD_DECODE_COLUMNS)
-    dist = steps["dist_food_cm"]
-    parts = [decode_table(hidden, steps[in_range], FOOD_TARGETS, folds).assign(food=food)
-             for food, in_range in (("near", dist <= near_cm), ("far", dist > near_cm))]
-    return pd.concat(parts, ignore_index=True)[FOOD_DECODE_COLUMNS]
 
 
 def _pair_states(hidden: pd.DataFrame, steps: pd.DataFrame,

@@ -41,14 +41,8 @@ from .behaviour import (
     theil_per_episode,
     win_ratios,
 )
-from .dynamics import (
-    decode_table,
-    dynamics_table,
-    food_decode_table,
-    plsc_collapse_table,
-    plsc_table,
-    subsample_table,
-)
+from .decoding import decode_episodes, food_decode_episodes, summarise
+from .dynamics import dynamics_table, plsc_collapse_table, plsc_table, subsample_table
 from .dynamics_tests import power_near_far, power_tests, size_tests
 from .homing import ERROR_COLUMNS, compare_perception, error_histogram, error_vs_time, trajectory_shape
 from .interactions import bite_rate_by_class, bite_sizes, bite_timing, bouts, chase_sizes, label_counts, size_role_tests
@@ -227,17 +221,20 @@ def _onepatch(t: Tables, cfg: EfishConfig) -> Tables:
 
 # --------------------------------------------------------------- dynamics
 def _dynamics(t: Tables, cfg: EfishConfig) -> Tables:
-    """Hidden-state dimensionality, power, unit subsampling, decoding (also of food near and far), PLSC of agents
-    0 and 1 with the test of fewer shared dimensions far than near, and the tests of D_eff against group size and of
-    wideband power by context (Fig 6)."""
+    """Hidden-state dimensionality, power, unit subsampling, decoding per episode and its mean over episodes (also of
+    food near and far; homing: the homer's states), PLSC of agents 0 and 1 with the test of fewer shared dimensions
+    far than near, and the tests of D_eff against group size and of wideband power by context (Fig 6)."""
     a, hidden, steps = cfg.analysis, t["hidden"], t["steps"]
     rng = np.random.default_rng(a.seed)
     dims = dynamics_table(hidden, a.variance_fraction, a.spectrogram_window, a.spectrogram_overlap, cfg.env.fps)
     control = control_condition(dims["condition"], cfg)
+    homer = _homer(cfg)
+    decoded = decode_episodes(hidden, steps, folds=a.decode_folds, agent=homer)
+    food = food_decode_episodes(hidden, steps, a.claims_food_near_cm, a.decode_folds, homer)
     return {"dimensionality": dims,
             "subsampling": subsample_table(hidden, a.subsample_fractions, a.subsample_draws, rng),
-            "decoding": decode_table(hidden, steps, folds=a.decode_folds),
-            "food_decoding": food_decode_table(hidden, steps, a.claims_food_near_cm, a.decode_folds),
+            "decoding": summarise(decoded), "decoding_episodes": decoded,
+            "food_decoding": summarise(food, by=("food",)), "food_decoding_episodes": food,
             "plsc": plsc_table(hidden, steps, (0, 1), a.plsc_edges_cm, a.plsc_shifts, rng, a.plsc_percentile,
                                a.plsc_null_draws, a.claims_alpha),
             "plsc_collapse": plsc_collapse_table(hidden, steps, (0, 1), a.plsc_edges_cm, a.plsc_null_draws,
@@ -276,8 +273,9 @@ ANALYSES: dict[str, Analysis] = {a.name: a for a in [
     Analysis("onepatch", _onepatch, ("steps", "conditions"), ("onepatch", "bot"),
              ("food_time_course", "reach_rates", "role_tests", "reach_tests"), ("role_tests", "reach_tests")),
     Analysis("dynamics", _dynamics, ("hidden", "steps"), ("patchy4", "wide2", "homing", "groupsize", "square2"),
-             ("dimensionality", "subsampling", "decoding", "food_decoding", "plsc", "plsc_collapse", "condition_tests",
-              "size_tests", "power_near_far", "power_tests"), ("condition_tests", "size_tests", "power_tests")),
+             ("dimensionality", "subsampling", "decoding", "decoding_episodes", "food_decoding",
+              "food_decoding_episodes", "plsc", "plsc_collapse", "condition_tests", "size_tests", "power_near_far",
+              "power_tests"), ("condition_tests", "size_tests", "power_tests")),
 ]}
 
 

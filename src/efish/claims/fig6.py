@@ -1,8 +1,9 @@
 """The claims of Fig 6 (C17-C21): the hidden dynamics: dimensionality, decoding, shared components, power.
 
-Decoding rule (docs/claims/index.md): a hidden state is decoded against the
-world it observed, never against the policy's own outputs or a per-agent
-constant.
+Decoding rule (docs/claims/index.md#rule-7): a hidden state is decoded against
+the world it observed, never ranked against copies of its own input (its last
+action, its size, summaries of its sensor inputs). C18 and C19 read the
+dynamics analysis's per-episode decoding skill, the numbers of Fig 6D-F.
 """
 
 from __future__ import annotations
@@ -13,19 +14,19 @@ import numpy as np
 import pandas as pd
 
 from ..analysis._tables import AGENT_EPISODE
-from ..analysis.decoding import heldout_skill
-from ..analysis.dynamics import DECODE_TARGETS, plsc
+from ..analysis.decoding import FOOD_TARGETS, SENSED_TARGETS
+from ..analysis.dynamics import plsc
 from ..analysis.dynamics_tests import groupsize_parts, smaller_larger
 from ..layout import analysis_table, assay_table
 from .context import Context, claim
-from .fig2 import HOMING_ELECTRIC, HOMING_STEPS
+from .fig2 import HOMING_ELECTRIC
 from .fig3 import WIDE2_STEPS
 from .intervals import smallest_p_signed_rank
-from .parts import joined, one_sample_part, paired_difference, per_episode, spearman_part
+from .parts import decoded, joined, one_sample_part, paired_difference, per_episode, spearman_part
 from .statistics import interaction_slope, rho_of
 from .verdicts import Outcome, Part
 
-HOMING_HIDDEN, WIDE2_HIDDEN = assay_table("homing", "hidden"), assay_table("wide2", "hidden")
+WIDE2_HIDDEN = assay_table("wide2", "hidden")
 
 
 @claim("C17", "6A-C", "hidden dynamics are low-dimensional; D_eff grows with group size only with Knollenorgans",
@@ -60,73 +61,61 @@ def c17(ctx: Context) -> list[Part]:
                      "minus off (the N x K interaction of D_eff ~ N * K over episodes); t-test", interaction)]
 
 
+HOMING_DECODING = analysis_table("dynamics", "homing", "decoding_episodes")
+
+
 @claim("C18", "6D", "the Knollenorgan error angle is decoded better than the straight bearing to the target",
-       [HOMING_HIDDEN, HOMING_STEPS])
+       [HOMING_DECODING])
 def c18(ctx: Context) -> list[Part]:
     def compute() -> Outcome:
-        j, h = joined(ctx, HOMING_HIDDEN, HOMING_STEPS, ["err_knollen_rad", "bearing_agent_rad"])
-        j = j[(j["condition"] == HOMING_ELECTRIC) & np.isfinite(j["err_knollen_rad"])]  # the homer's steps
-        if j.empty:
-            raise ValueError("no electric homing step with a Knollenorgan error angle and a hidden state")
-        skills = heldout_skill(j[h].to_numpy(), {"err_knollen_rad": (j["err_knollen_rad"].to_numpy(), True),
-                                                 "bearing_agent_rad": (j["bearing_agent_rad"].to_numpy(), True)},
-                               j["episode"].to_numpy(), ctx.cfg.analysis.decode_folds)
+        skills = decoded(ctx, HOMING_DECODING, ["err_knollen_rad", "bearing_agent_rad"], condition=HOMING_ELECTRIC)
         out = paired_difference(ctx, skills, "err_knollen_rad", "bearing_agent_rad")
         # faithful to the paper, and partly mechanical: the binarised Knollenorgan signs encode the target field's
         # direction relative to the body, while the straight bearing is not observed
         note = "partly by construction: the Knollenorgan signs encode the field direction, the bearing is unobserved"
         return dataclasses.replace(out, reason="; ".join(r for r in (out.reason, note) if r))
-    return [ctx.part("err vs bearing", "Hodges-Lehmann estimate over episodes of held-out decoding skill (1 - MSE / MSE of the "
-                     "train mean) of err_knollen minus bearing to the target; Wilcoxon", compute)]
+    return [ctx.part("err vs bearing", "Hodges-Lehmann estimate over episodes of held-out decoding skill (1 - SSE / SSE "
+                     "of the training mean, dynamics decoding_episodes of the homer) of err_knollen minus bearing to "
+                     "the target; Wilcoxon", compute)]
 
 
-#: Fig 6E's sensed variables (decoding rule: never the policy's own outputs or the agent's constant size), and
-#: among them the agent and Knollenorgan features the paper finds best.
-SENSED = {"dist_agent_cm": False, "knollen_spikes": False, "n_agents_100cm": False, "log_morm_sensed": False,
-          "dist_wall_cm": False}
-AGENT_FEATURES = ("dist_agent_cm", "knollen_spikes", "n_agents_100cm")
-FOOD_FEATURES = ("dist_food_cm", "bearing_food_rad")
+#: Among the sensed variables (efish.analysis.decoding.SENSED_TARGETS, the ones Fig 6E ranks), the nearest-agent
+#: distance and the Knollenorgan feature (agents in Knollenorgan range) the paper finds best.
+AGENT_FEATURES = ("dist_agent_cm", "n_agents_100cm")
+WIDE2_DECODING = analysis_table("dynamics", "wide2", "decoding")
+WIDE2_DECODED = analysis_table("dynamics", "wide2", "decoding_episodes")
+WIDE2_FOOD_DECODED = analysis_table("dynamics", "wide2", "food_decoding_episodes")
 
 
 @claim("C19", "6E,F", "nearest-agent distance and Knollenorgan features decode best; food variables decode better "
-       "when food is in range", [WIDE2_HIDDEN, WIDE2_STEPS])
+       "when food is in range", [WIDE2_DECODING, WIDE2_DECODED, WIDE2_FOOD_DECODED])
 def c19(ctx: Context) -> list[Part]:
-    folds = ctx.cfg.analysis.decode_folds
     near_cm = ctx.cfg.analysis.claims_food_near_cm
 
     def ranking() -> Outcome:
-        missing = [c for c in SENSED if c not in ctx.table(WIDE2_STEPS).columns]
-        if missing:
-            raise ValueError(f"the wide2 steps table lacks the sensed variables {missing}: rerun the assay")
-        j, h = joined(ctx, WIDE2_HIDDEN, WIDE2_STEPS, list(SENSED))
-        # a step where no Mormyromast reads above E_min is recorded as NaN; the channel then delivers its floor
-        # (every normalised reading 0), so it is decoded as log10 E_min there: every variable on the same steps
-        j["log_morm_sensed"] = j["log_morm_sensed"].fillna(np.log10(ctx.cfg.sensors.mormyromast.e_min))
-        j = j[np.isfinite(j[list(SENSED)].astype(np.float64)).all(axis=1)]
-        skills = heldout_skill(j[h].to_numpy(), {c: (j[c].to_numpy(), SENSED[c]) for c in SENSED},
-                               j["episode"].to_numpy(), folds)
-        mean = skills.groupby("target")["skill"].mean()
-        ours, rest = mean.reindex(AGENT_FEATURES).dropna(), mean.drop(list(AGENT_FEATURES), errors="ignore")
+        """The best agent feature against the best other sensed variable, ranked by Fig 6E's pooled skill (dynamics
+        decoding), paired over the episodes of decoding_episodes."""
+        summary = ctx.table(WIDE2_DECODING)
+        skill = summary[summary["target"].isin(list(SENSED_TARGETS))].groupby("target")["skill"].mean().dropna()
+        ours, rest = skill.reindex(AGENT_FEATURES).dropna(), skill.drop(list(AGENT_FEATURES), errors="ignore")
         if ours.empty or rest.empty:
             raise ValueError("no agent or no other sensed variable with a finite decoding skill")
-        out = paired_difference(ctx, skills, ours.idxmax(), rest.idxmax())
-        ranked = ", ".join(f"{k} {v:.2f}" for k, v in mean.sort_values(ascending=False).items())
-        return dataclasses.replace(out, reason="; ".join(r for r in (out.reason, f"mean skill: {ranked}") if r))
+        best, other = ours.idxmax(), rest.idxmax()
+        out = paired_difference(ctx, decoded(ctx, WIDE2_DECODED, [best, other]), best, other)
+        ranked = ", ".join(f"{k} {v:.2f}" for k, v in skill.sort_values(ascending=False).items())
+        return dataclasses.replace(out, reason="; ".join(r for r in (out.reason, f"skill (Fig 6E): {ranked}") if r))
 
     def food() -> Outcome:
-        j, h = joined(ctx, WIDE2_HIDDEN, WIDE2_STEPS, list(FOOD_FEATURES))
-        j = j.dropna(subset=list(FOOD_FEATURES))
-        parts = []
-        for name, sub in (("near", j[j["dist_food_cm"] <= near_cm]), ("far", j[j["dist_food_cm"] > near_cm])):
-            s = heldout_skill(sub[h].to_numpy(), {c: (sub[c].to_numpy(), DECODE_TARGETS[c]) for c in FOOD_FEATURES},
-                              sub["episode"].to_numpy(), folds)
-            parts.append(s.groupby("group", as_index=False)["skill"].mean().assign(target=name))
-        return paired_difference(ctx, pd.concat(parts, ignore_index=True), "near", "far")
+        """Per episode, the mean skill of the food variables near minus far (dynamics food_decoding_episodes)."""
+        skills = decoded(ctx, WIDE2_FOOD_DECODED, list(FOOD_TARGETS))
+        per = skills.groupby(["condition", "episode", "food"], as_index=False)["skill"].mean()
+        return paired_difference(ctx, per, "near", "far", key="food")
     return [ctx.part("agent features best", "Hodges-Lehmann estimate over episodes of held-out skill of the best agent or "
-                     "Knollenorgan feature minus the best other sensed variable (wide2; turn, EOD, bite and size "
-                     "excluded); Wilcoxon", ranking),
+                     "Knollenorgan feature minus the best other sensed variable (wide2, dynamics decoding_episodes; "
+                     "readouts of the network's own input excluded); Wilcoxon", ranking),
             ctx.part("food near > far", f"Hodges-Lehmann estimate over episodes of held-out skill of food distance and bearing, "
-                     f"nearest pellet within {near_cm:g} cm minus beyond; Wilcoxon", food)]
+                     f"nearest pellet within {near_cm:g} cm minus beyond (dynamics food_decoding_episodes); Wilcoxon",
+                     food)]
 
 
 WIDE2_COLLAPSE = analysis_table("dynamics", "wide2", "plsc_collapse")

@@ -156,13 +156,32 @@ def joined(ctx: Context, hidden: str, steps: str, columns: list[str]) -> tuple[p
 
 
 def paired_difference(ctx: Context, long: pd.DataFrame, better: str, worse: str, value: str = "skill",
-                      key: str = "target", unit: str = "group", sign: int = +1) -> Outcome:
-    """Signed-rank test over ``unit`` (episodes) of ``value`` where ``key`` is ``better`` minus where it is
-    ``worse`` (e.g. two decoding targets' held-out skill), units with both only (:func:`signed_rank_outcome`)."""
-    wide = long.pivot(index=unit, columns=key, values=value)
+                      key: str = "target", unit: str | Iterable[str] = ("condition", "episode"),
+                      sign: int = +1) -> Outcome:
+    """Signed-rank test over ``unit`` (the columns that name an episode) of ``value`` where ``key`` is ``better``
+    minus where it is ``worse`` (e.g. two decoding targets' held-out skill), units with both only
+    (:func:`signed_rank_outcome`)."""
+    wide = long.pivot(index=unit if isinstance(unit, str) else list(unit), columns=key, values=value)
     present(pd.DataFrame({key: list(wide.columns)}), key, [better, worse], f"{value}")
     diff = (wide[better] - wide[worse]).dropna()
     return signed_rank_outcome(ctx, diff.to_numpy(np.float64), sign)
+
+
+def decoded(ctx: Context, path: str, targets: Iterable[str], **match) -> pd.DataFrame:
+    """The rows of a per-episode decoding table (dynamics ``decoding_episodes``, ``food_decoding_episodes``) of
+    ``targets`` matching ``match`` (e.g. condition=...) with a finite skill; a ValueError with the analysis's reason
+    when a target has none (a column the rollout lacks, too few episodes)."""
+    rows = ctx.table(path)
+    rows = rows[rows["target"].isin(list(targets))]
+    for column, value in match.items():
+        rows = rows[rows[column] == value]
+    for target in targets:
+        mine = rows[rows["target"] == target]
+        if not np.isfinite(mine["skill"].to_numpy(np.float64)).any():
+            reasons = sorted({r for r in mine["reason"] if isinstance(r, str) and r})
+            why = "; ".join(reasons) or "no row" + "".join(f", {k} {v}" for k, v in match.items())
+            raise ValueError(f"no decoding skill of {target} ({why}) in {path}")
+    return rows[np.isfinite(rows["skill"].to_numpy(np.float64))]
 
 
 # ------------------------------------------------- paired and equivalence parts (paired tests, equivalence, ceilings)

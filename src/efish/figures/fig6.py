@@ -4,12 +4,13 @@
 Panels read the dynamics analysis (``analysis/dynamics/<assay>/``):
 ``dimensionality`` (D_eff, PCs for the variance fraction and wideband power
 per agent-episode), ``subsampling`` (D_eff of random unit subsets),
-``decoding`` (cross-validated score per target), ``plsc`` (per distance
-bin), ``power_near_far`` and the statistic tables ``size_tests`` (D_eff
-against N) and ``power_tests`` (near vs far, smaller vs larger), whose stars
-the panels draw. Where the analysis does not yet write what a panel needs (the
-PCA variance spectrum, decoding split by food distance), the panel draws what
-there is and its caption, or the panel itself, says what is missing.
+``decoding`` and ``food_decoding`` (held-out decoding skill per target,
+pooled over episodes), ``plsc`` (per distance bin), ``power_near_far`` and
+the statistic tables ``size_tests`` (D_eff against N) and ``power_tests``
+(near vs far, smaller vs larger), whose stars the panels draw. Where the
+analysis does not yet write what a panel needs (the PCA variance spectrum),
+the panel draws what there is and its caption, or the panel itself, says what
+is missing.
 """
 
 from __future__ import annotations
@@ -44,7 +45,7 @@ GROUPSIZE_CONDITION = re.compile(r"^n(\d+)_(K|noK)$")
 KNOLLENORGAN_STATE = {"K": "K on", "noK": "K off"}
 KNOLLENORGAN_COLOURS = {"K on": RECEPTOR_COLOURS["knollenorgan"], "K off": NEUTRAL_COLOUR}
 KNOLLENORGAN_STYLES = {"K on": "-", "K off": "--"}
-#: Readable names of the decoding targets (steps columns, efish.analysis.dynamics.DECODE_TARGETS; a few older
+#: Readable names of the decoding targets (steps columns, efish.analysis.decoding.DECODE_TARGETS; a few older
 #: targets too, so that the tables of earlier runs still draw with names).
 TARGET_LABELS = {
     "dist_agent_cm": "nearest agent: distance", "bearing_agent_rad": "nearest agent: bearing",
@@ -54,11 +55,15 @@ TARGET_LABELS = {
     "dist_food_cm": "food: distance", "bearing_food_rad": "food: bearing", "food_count_5cm": "pellets within 5 cm",
     "dist_wall_cm": "wall: distance", "bearing_wall_rad": "wall: bearing", "size": "own size", "eod": "own EOD",
     "turn_rad": "turn", "log_morm_field": "log field (M, geometric)", "log_morm_sensed": "log reading (M, sensed)",
-    "log_amp_field": "log field (A)",
+    "log_amp_field": "log field (A)", "knollen_spikes": "K inputs spiking", "err_knollen_rad": "error angle (K)",
+    "err_morm_rad": "error angle (M)", "err_amp_rad": "error angle (A)",
 }
-#: Appended to the label of a readout target (the policy's own output or size).
+#: Appended to the label of a readout target (a copy of the network's own input: its last action, size, sensor inputs).
 READOUT_SUFFIX = " (readout)"
 READOUT_HATCH = "////"
+#: The decoding tables' column the bars draw (efish.analysis.decoding.summarise) and its axis label.
+SKILL = "skill"
+SKILL_LABEL = "held-out decoding skill"
 POWER_LABEL = "wideband power (1/Hz)"
 
 
@@ -129,43 +134,45 @@ def subsampling_curves(tables: Tables, ax) -> None:
 
 
 def readout_rows(decoding: pd.DataFrame) -> pd.Series:
-    """Which rows of a decoding table are readouts of the decoded vector (docs/claims/index.md#rule-7): its ``readout``
-    column, or, in a table written before that column existed, membership of efish.analysis.dynamics.READOUT_TARGETS."""
+    """Which rows of a decoding table are readouts of the network's own input (docs/claims/index.md#rule-7): its
+    ``readout`` column, or, in a table written before that column existed, membership of
+    efish.analysis.decoding.READOUT_TARGETS."""
     if "readout" in decoding.columns:
         return decoding["readout"].fillna(False).astype(bool)
-    # imported here: the workflow imports every figure module to list the panels, and dynamics pulls in sklearn
-    from ..analysis.dynamics import READOUT_TARGETS
+    # imported here: the workflow imports every figure module to list the panels, and the analysis is heavier
+    from ..analysis.decoding import READOUT_TARGETS
 
     return decoding["target"].isin(list(READOUT_TARGETS))
 
 
 def decoding_bars(assay: str, title: str, control: str | None = None):
-    """A draw function: decoding score per target, one bar colour per condition (``control``, default the assay's
-    first condition, grey).
+    """A draw function: held-out decoding skill per target (pooled over episodes, the dynamics decoding table), one
+    bar colour per condition (``control``, default the assay's first condition, grey).
 
-    The sensed targets are ranked, best on top; the readouts (the policy's own
-    turn and EOD, its own size: not sensing) are not ranked
-    among them: they follow below a dashed line, hatched, labelled "(readout)".
+    The sensed targets are ranked, best on top, as claim C19 ranks them; the
+    readouts (copies of the network's input: its last turn and EOD, its own
+    size, summaries of its sensor inputs) are not ranked among them: they
+    follow below a dashed line, hatched, labelled "(readout)".
     """
     def draw(tables: Tables, ax) -> None:
         import seaborn as sns
 
         decoding = tables["decoding"]
-        scored = decoding[np.isfinite(pd.to_numeric(decoding["score"], errors="coerce"))]
+        scored = decoding[np.isfinite(pd.to_numeric(decoding[SKILL], errors="coerce"))]
         if scored.empty:
             reasons = [r for r in decoding["reason"].astype(str) if r and r != "nan"]
-            missing(ax, f"no decoding score in {assay}: {reasons[0] if reasons else 'empty table'}")
+            missing(ax, f"no decoding skill in {assay}: {reasons[0] if reasons else 'empty table'}")
             return
         readout = readout_rows(scored)
         scored = scored.assign(label=scored["target"].map(lambda t: TARGET_LABELS.get(t, t))
                                + np.where(readout, READOUT_SUFFIX, ""))
 
         def ranked(rows: pd.DataFrame) -> list[str]:
-            return rows.groupby("label")["score"].mean().sort_values(ascending=False).index.tolist()
+            return rows.groupby("label")[SKILL].mean().sort_values(ascending=False).index.tolist()
 
         sensed, readouts = ranked(scored[~readout]), ranked(scored[readout])
         conditions = condition_order(tables, assay, scored["condition"], control)
-        sns.barplot(data=scored, x="score", y="label", hue="condition", order=sensed + readouts,
+        sns.barplot(data=scored, x=SKILL, y="label", hue="condition", order=sensed + readouts,
                     hue_order=conditions, palette=condition_palette(conditions, control), orient="h",
                     legend=len(conditions) > 1, ax=ax)
         for bar in ax.patches:  # bars sit at y = their label's index in the order
@@ -175,7 +182,7 @@ def decoding_bars(assay: str, title: str, control: str | None = None):
         if sensed and readouts:
             ax.axhline(len(sensed) - 0.5, color=NEUTRAL_COLOUR, lw=0.5, ls="--")
         ax.axvline(0.0, color="black", lw=0.5)
-        ax.set_xlabel("decoding score (R$^2$ - baseline R$^2$)")
+        ax.set_xlabel(SKILL_LABEL)
         ax.set_ylabel("decoded variable")
         ax.tick_params(axis="y", labelsize=6)
         ax.set_title(title)
@@ -186,24 +193,24 @@ def decoding_bars(assay: str, title: str, control: str | None = None):
 
 
 def food_decoding_bars(tables: Tables, ax) -> None:
-    """Panel F: decoding score of the food variables with the nearest food in receptor range (near) and beyond it
+    """Panel F: decoding skill of the food variables with the nearest food in receptor range (near) and beyond it
     (far), one bar pair per variable, from the dynamics food_decoding table of wide2 (conditions pooled by mean)."""
     import seaborn as sns
 
     table = tables["food_decoding"]
-    scored = table[np.isfinite(pd.to_numeric(table.get("score", pd.Series(dtype=float)), errors="coerce"))]
+    scored = table[np.isfinite(pd.to_numeric(table.get(SKILL, pd.Series(dtype=float)), errors="coerce"))]
     if scored.empty:
         reasons = [r for r in table.get("reason", pd.Series(dtype=str)).astype(str) if r and r != "nan"]
-        missing(ax, f"no food decoding score in wide2: {reasons[0] if reasons else 'empty table'}")
+        missing(ax, f"no food decoding skill in wide2: {reasons[0] if reasons else 'empty table'}")
         return
     scored = scored.assign(label=scored["target"].map(lambda t: TARGET_LABELS.get(t, t)))
     ranges = [r for r in FOOD_RANGE_COLOURS if r in set(scored["food"])]
-    sns.barplot(data=scored, x="score", y="label", hue="food", hue_order=ranges, palette=FOOD_RANGE_COLOURS,
+    sns.barplot(data=scored, x=SKILL, y="label", hue="food", hue_order=ranges, palette=FOOD_RANGE_COLOURS,
                 orient="h", errorbar=None, ax=ax)
     ax.axvline(0.0, color="black", lw=0.5)
     near = analysis_config(tables, "wide2").claims_food_near_cm
     ax.legend(title=f"food (near: <= {near:g} cm)", fontsize=6, title_fontsize=6, loc="best")
-    ax.set_xlabel("decoding score (R$^2$ - baseline R$^2$)")
+    ax.set_xlabel(SKILL_LABEL)
     ax.set_ylabel("decoded variable")
     ax.set_title("Two agents: food near vs far")
 
@@ -327,21 +334,24 @@ PANELS = [
           "group size (colour) and Knollenorgan state (dashed: off), groupsize assay, "
           "analysis/dynamics/groupsize/subsampling."),
     Panel("fig6", "D", decoding_bars("homing", "Homing: decoding", control="raycast"), {"decoding": _dyn("homing", "decoding")},
-          "Cross-validated linear decoding of step variables from the homer's hidden state (score = held-out R^2 "
-          "minus that of the training mean; folds grouped by episode), electric and ray-casting homing policies, "
-          "analysis/dynamics/homing/decoding; targets without a score (e.g. no food in the arena) are left out. "
-          "Readouts of the state itself (own turn, EOD, size) are drawn hatched below the dashed line, not ranked. "
-          "The Knollenorgan error angle is not a decoding target of the analysis yet."),
+          "Linear decoding of step variables from the homer's hidden state, electric and ray-casting homing "
+          "policies: held-out skill (1 - SSE of the readout / SSE of the training mean, on each episode held out "
+          "whole by analysis.decode_folds-fold cross-validation), pooled over episodes, analysis/dynamics/homing/decoding (per episode: "
+          "decoding_episodes, which claim C18 tests); targets without a skill (e.g. no food in the arena) are left "
+          "out. Readouts of the network's own input (its last turn and EOD, its size, its Knollenorgan inputs "
+          "spiking, its largest Mormyromast input) are drawn hatched below the dashed line, not ranked."),
     Panel("fig6", "E", decoding_bars("wide2", "Two agents: decoding"), {"decoding": _dyn("wide2", "decoding")},
-          "Decoding score per step variable from the hidden state of both agents of the wide2 assay (160 x 40 cm), "
-          "analysis/dynamics/wide2/decoding. Each state is decoded against the world it has observed (the step's "
-          "observation it has taken in). The sensed variables are ranked best first; the readouts of the decoded "
-          "vector itself (the agent's own turn and EOD, fed back in its observation, and its own size) are drawn "
-          "hatched below the dashed line and not ranked (decode only sensed variables). Targets without a score are left out."),
+          "Held-out decoding skill per step variable from the hidden state of both agents of the wide2 assay "
+          "(160 x 40 cm), pooled over episodes, analysis/dynamics/wide2/decoding. Each state is decoded against the "
+          "world it has observed (the step's observation it has taken in). The sensed variables are ranked best "
+          "first, as claim C19 ranks them; the readouts of the network's own input (its last turn and EOD, its own "
+          "size, its Knollenorgan inputs spiking and its largest Mormyromast input) are drawn hatched below the "
+          "dashed line and not ranked. Targets without a skill are left out."),
     Panel("fig6", "F", food_decoding_bars, {"food_decoding": _dyn("wide2", "food_decoding")},
-          "Decoding score of the food variables (distance and bearing of the nearest pellet) from the hidden states "
-          "of the wide2 agents on the steps with that pellet within analysis.claims_food_near_cm (near, in receptor "
-          "range) and beyond it (far); analysis/dynamics/wide2/food_decoding. Claim C19 tests near > far."),
+          "Held-out decoding skill of the food variables (distance and bearing of the nearest pellet) from the "
+          "hidden states of the wide2 agents on the steps with that pellet within analysis.claims_food_near_cm "
+          "(near, in receptor range) and beyond it (far), pooled over episodes; "
+          "analysis/dynamics/wide2/food_decoding. Claim C19 tests near > far on its episodes."),
     Panel("fig6", "G", plsc_bars("s_1", "first PLSC singular value", "PLSC: first component"),
           {"plsc": _dyn("wide2", "plsc")},
           "Partial least squares correlation of the two wide2 agents' z-scored hidden states per pair-distance bin "
