@@ -7,9 +7,10 @@ only holds fixtures. Configs are composed once per distinct override set
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import hashlib
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -30,6 +31,20 @@ def conditions_of(assay: str, *overrides: str) -> pd.DataFrame:
     """``assays/<assay>/conditions.parquet`` as efish assay records it at the smoke scale under ``overrides``
     (e.g. ``env.fps=25``): every condition's resolved config. Shared: copy before editing."""
     return conditions_table(condition_configs(["scale=smoke", *overrides, f"assay={assay}"]))
+
+
+def recorded_table(conditions: Iterable[str] | Mapping[str, Sequence[str]] = ("control", "treated"),
+                   *overrides: str) -> pd.DataFrame:
+    """``conditions.parquet`` as efish assay would record an assay of ``conditions`` (names, or name -> that
+    condition's own overrides, e.g. ``{"slow": ["env.fps=41.5"]}``) at the smoke scale under ``overrides``: the
+    record of synthetic rollout tables, whose condition names no assay file has. The first is the control."""
+    own = dict(conditions) if isinstance(conditions, Mapping) else {c: () for c in conditions}
+    listed = {name: [str(o) for o in extra] for name, extra in own.items()}
+    configs = {}
+    for name, extra in own.items():
+        cfg = cfg_with("scale=smoke", *overrides, *extra)
+        configs[name] = dataclasses.replace(cfg, assay=dataclasses.replace(cfg.assay, conditions=listed))
+    return conditions_table(configs)
 
 
 @functools.lru_cache(maxsize=None)
@@ -103,7 +118,8 @@ def rollout_tables(seed: int = 0, conditions=("control", "treated"), episodes: i
                    steps: int = 120, units: int = 8, bite_target: bool = True, error_angles: bool = False,
                    arena_cm: float = 70.0) -> dict:
     """Synthetic rollout tables with the columns of ``efish.rollout.schema`` (steps, episodes, food), a
-    ``hidden`` table keyed like steps (``h_0 .. h_{units-1}``) and, by choice, the columns the assays issue adds
+    ``hidden`` table keyed like steps (``h_0 .. h_{units-1}``), the ``conditions`` record of ``conditions`` at
+    the default settings (:func:`recorded_table`) and, by choice, the columns the assays issue adds
     (``bite_target``; ``err_*_rad``). Agents random-walk in the middle 30 cm so that pairs meet, bite and
     chase; bigger agents discharge and eat more, so that size effects exist."""
     import pandas as pd
@@ -126,7 +142,7 @@ def rollout_tables(seed: int = 0, conditions=("control", "treated"), episodes: i
     if error_angles:
         s = s.assign(**{c: rng.vonmises(0.0, 2.0, len(s)) for c in ("err_morm_rad", "err_amp_rad", "err_knollen_rad")})
     return {"steps": s, "episodes": _episodes_of(s), "food": pd.concat(food, ignore_index=True),
-            "hidden": pd.concat(hidden, ignore_index=True)}
+            "hidden": pd.concat(hidden, ignore_index=True), "conditions": recorded_table(conditions)}
 
 
 def _episode_steps(rng, cond: str, episode: int, n: int, steps: int, arena_cm: float):

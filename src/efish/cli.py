@@ -63,6 +63,7 @@ from .cli_claims import run_claims, run_claims_by_stage, run_compare_claims
 from .cli_support import run_of, write_metadata
 from .config import ConfigError, compose, to_yaml
 from .layout import (
+    ANALYSIS_SETTINGS,
     BENCH,
     CLAIMS_BY_STAGE,
     CLAIMS_BY_STAGE_FIGURE,
@@ -368,13 +369,18 @@ def _stack_seeds(args, cfg, started) -> None:
 
 
 def _analyze(args, cfg, started) -> None:
+    """One analysis of an assay's record (its rollout tables and recorded conditions) under the analysis settings
+    of ``cfg``, which it writes beside the tables (``analysis_settings.parquet``) for the panels and claims."""
     from .analysis.registry import read_tables, run
+    from .config.recorded import settings_table
     from .io import write_parquet_tables
 
-    result = run(args.name, read_tables(args.name, args.tables), cfg)  # everything is read before anything is written
-    write_parquet_tables(result, args.out)
+    # everything is read before anything is written
+    result = run(args.name, read_tables(args.name, args.tables), cfg.analysis)
+    write_parquet_tables({**result, ANALYSIS_SETTINGS: settings_table(cfg.analysis)}, args.out)
     write_metadata(args.out, cfg, started, args, analysis=args.name, tables=str(args.tables))
-    print(f"wrote {', '.join(f'{k}.parquet ({len(v)} rows)' for k, v in result.items())} to {args.out}")
+    print(f"wrote {', '.join(f'{k}.parquet ({len(v)} rows)' for k, v in result.items())} and "
+          f"{ANALYSIS_SETTINGS}.parquet to {args.out}")
 
 
 def _scene(args, cfg, started) -> None:

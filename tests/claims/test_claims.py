@@ -33,7 +33,7 @@ from efish.cli import main
 from efish.config.recorded import recorded_conditions
 from efish.layout import analysis_table, assay_table
 
-from ..helpers import REPO, cfg_with, conditions_of, rollout_tables
+from ..helpers import REPO, cfg_with, conditions_of, recorded_table, rollout_tables
 
 CFG = cfg_with("analysis.claims_resamples=40", "analysis.claims_fit_resamples=4")
 A, R = analysis_table, assay_table
@@ -141,7 +141,7 @@ def wide_steps(flip: bool, episodes: int = 8, steps: int = 600, null: bool = Fal
 
 
 def c5(flip):
-    return {R("wide2", "steps"): wide_steps(flip)}
+    return {R("wide2", "steps"): wide_steps(flip), R("wide2", "conditions"): recorded_table(("control",))}
 
 
 c6 = c5
@@ -544,7 +544,7 @@ def test_the_authors_self_only_mode_is_reported_beside_and_does_not_decide():
 
 def test_c6_without_a_planted_event_effect_is_weaker_with_a_proper_interval():
     """EOD probability unrelated to the events: no part holds or fails, and each interval spans 0 with a width."""
-    _, assessed = cl.CLAIMS["C6"].assess({R("wide2", "steps"): wide_steps(False, null=True)}, CFG)
+    _, assessed = cl.CLAIMS["C6"].assess({**c6(False), R("wide2", "steps"): wide_steps(False, null=True)}, CFG)
     parts = pd.DataFrame(part_rows("C6", assessed), columns=PART_COLUMNS)
     assert (parts["verdict"] == "weaker").all(), parts[["part", "verdict", "reason"]]
     assert ((parts["ci_low"] < 0) & (parts["ci_high"] > 0)).all(), parts[["part", "ci_low", "ci_high"]]
@@ -673,7 +673,7 @@ def results(tmp_path_factory):
         for name in ("steps", "episodes"):
             (root / "assays" / assay).mkdir(parents=True, exist_ok=True)
             tables[name].to_parquet(root / "assays" / assay / f"{name}.parquet")
-        out = run("behaviour", tables, cfg)
+        out = run("behaviour", tables, cfg.analysis)
         (root / "analysis" / "behaviour" / assay).mkdir(parents=True)
         for name, table in out.items():
             table.to_parquet(root / "analysis" / "behaviour" / assay / f"{name}.parquet")
