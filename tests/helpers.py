@@ -18,6 +18,7 @@ import pandas as pd
 
 from efish import Snapshot
 from efish.config import compose
+from efish.config.schema import EnvConfig
 from efish.physics import Scene, build_plan
 from efish.rollout.assay import condition_configs
 from efish.rollout.conditions import conditions_table
@@ -143,6 +144,30 @@ def rollout_tables(seed: int = 0, conditions=("control", "treated"), episodes: i
         s = s.assign(**{c: rng.vonmises(0.0, 2.0, len(s)) for c in ("err_morm_rad", "err_amp_rad", "err_knollen_rad")})
     return {"steps": s, "episodes": _episodes_of(s), "food": pd.concat(food, ignore_index=True),
             "hidden": pd.concat(hidden, ignore_index=True), "conditions": recorded_table(conditions)}
+
+
+#: Steps per second of env.fps's default (83) and half of it: the frame rates of :func:`planted_rate_tables`.
+DEFAULT_FPS = float(EnvConfig().fps)
+HALF_FPS = DEFAULT_FPS / 2
+
+
+def planted_rate_tables(period: int = 5, leader_period: int | None = None, seed: int = 7) -> dict:
+    """Rollout tables of one assay with two conditions that hold the same steps and hidden states: ``default``,
+    recorded at env.fps's default (83), and ``slow``, recorded at half of it (its ``conditions`` record, as efish
+    assay writes it). Every agent discharges on every ``period``-th step (agent 0 on every ``leader_period``-th,
+    when given) and eats at steps 30, 60 and 90: a known EOD probability per step, 1 / period, so a known rate in
+    Hz, fps / period, at each condition's recorded rate."""
+    tables = rollout_tables(seed=seed, conditions=("default",), episodes=3, n_agents=4, steps=120)
+    steps = tables["steps"]
+    every = np.where(steps["agent"] == 0, leader_period or period, period)
+    steps = steps.assign(eod=steps["t"] % every == 0, ate=steps["t"].isin([30, 60, 90]))
+
+    def both(table: pd.DataFrame) -> pd.DataFrame:
+        return pd.concat([table, table.assign(condition="slow")], ignore_index=True)
+    steps = both(steps)
+    return {"steps": steps, "episodes": _episodes_of(steps), "food": both(tables["food"]),
+            "hidden": both(tables["hidden"]),
+            "conditions": recorded_table({"default": [], "slow": [f"env.fps={HALF_FPS:g}"]})}
 
 
 def _episode_steps(rng, cond: str, episode: int, n: int, steps: int, arena_cm: float):

@@ -13,7 +13,15 @@ from efish.analysis.stats import STAT_COLUMNS
 from efish.config import config_dir
 from efish.rollout.schema import SCHEMAS, to_table
 
-from ..helpers import cfg_with, conditions_of, recorded_table, rollout_tables
+from ..helpers import (
+    DEFAULT_FPS,
+    HALF_FPS,
+    cfg_with,
+    conditions_of,
+    planted_rate_tables,
+    recorded_table,
+    rollout_tables,
+)
 
 #: The assays of docs/methods/assays.md (config/assay/<name>.yaml as they land).
 SPEC_ASSAYS = {"homing", "patchy4", "uniform4", "wide2", "square2", "ablation4", "ablation1", "collective", "mute",
@@ -111,6 +119,53 @@ def test_settings_and_the_recorded_rate_reach_the_functions(tables, tmp_path):
     assert out["idi_histogram"].groupby(["source", "condition"], dropna=False).size().eq(7).all()
     assert np.isfinite(out["power_law"].set_index("source").loc["real_fish", "alpha"])
     np.testing.assert_allclose(out["idis"]["idi_ms"], out["idis"]["idi_steps"] * 10.0)  # 1000 / env.fps
+
+
+def test_a_planted_eod_rate_comes_out_in_hz_at_each_recorded_frame_rate():
+    """Issue 38: one condition of the assay recorded at half the default env.fps. Every agent discharges on every
+    5th step, so its rate is fps / 5: 16.6 Hz at 83 steps per second, 8.3 Hz at 41.5. The signalling tables say so
+    in each condition's own Hz and ms, the dynamics power is per Hz of each condition's rate, and nothing of the
+    rate comes from the job's settings (the schema's default env.fps would give 16.6 Hz for both)."""
+    settings = cfg_with("scale=smoke").analysis
+    tables = planted_rate_tables(period=5)
+    fps = {"default": DEFAULT_FPS, "slow": HALF_FPS}
+    assert HALF_FPS == DEFAULT_FPS / 2 and fps["slow"] == 41.5
+    out = run("signalling", tables, settings)
+
+    def of(table: pd.DataFrame, condition: str) -> pd.DataFrame:
+        return table[table["condition"] == condition]
+    for cond, rate in fps.items():
+        by_distance = of(out["rate_by_distance"], cond).dropna(subset=["mean_hz"])
+        assert len(by_distance) and by_distance["mean_hz"].to_numpy() == pytest.approx(rate / 5)
+        peri = of(out["peri_event"], cond).dropna(subset=["mean_hz"])
+        assert len(peri) and peri["mean_hz"].to_numpy() == pytest.approx(rate / 5)
+        np.testing.assert_allclose(peri["lag_ms"], peri["lag"] * 1000.0 / rate)
+        ids = of(out["idis"], cond)
+        assert (ids["idi_steps"] == 5).all() and ids["idi_ms"].to_numpy() == pytest.approx(5000.0 / rate)
+        fit = of(out["power_law"], cond).iloc[0]  # the agents' fit (the real fish's has no condition)
+        assert fit["xmin"] == pytest.approx(fit["xmin_steps"] * 1000.0 / rate)
+    # agent 0 discharges on every 4th step: 0.05 x fps Hz above every partner of its pairs, 0 between the others
+    leader = run("signalling", planted_rate_tables(period=5, leader_period=4), settings)["rate_advantage"]
+    for cond, rate in fps.items():
+        rows = of(leader, cond)
+        assert (rows["agent"] == 0).any() and (rows["agent"] > 0).any()
+        expected = np.where(rows["agent"] == 0, 0.05 * rate, 0.0)
+        np.testing.assert_allclose(rows["rate_advantage_hz"], expected, atol=1e-9)
+    # the same hidden states at half the steps per second: twice the spectral density per Hz
+    dims = run("dynamics", tables, settings)["dimensionality"].set_index(["condition", "episode", "agent"])
+    ratio = dims.loc["slow", "wideband_power"] / dims.loc["default", "wideband_power"]
+    assert len(ratio) and ratio.to_numpy() == pytest.approx(2.0)
+
+
+def test_the_control_is_the_first_recorded_condition_present(tables):
+    """Condition tests compare with the assay's first recorded condition; when it is absent, with the next one
+    recorded (not the first in sorted order)."""
+    recorded = recorded_table(("treated", "control"))
+    out = run("behaviour", {**tables, "conditions": recorded}, cfg_with().analysis)["condition_tests"]
+    assert (out["control"] == "treated").all() and (out["group"] == "control").all()
+    three = recorded_table(("absent", "treated", "control"))
+    out = run("behaviour", {**tables, "conditions": three}, cfg_with().analysis)["condition_tests"]
+    assert (out["control"] == "treated").all()
 
 
 def test_scheduling_follows_the_tables_an_assay_writes():

@@ -33,7 +33,7 @@ from efish.cli import main
 from efish.config.recorded import recorded_conditions
 from efish.layout import analysis_table, assay_table
 
-from ..helpers import REPO, cfg_with, conditions_of, recorded_table, rollout_tables
+from ..helpers import DEFAULT_FPS, HALF_FPS, REPO, cfg_with, conditions_of, recorded_table, rollout_tables
 
 CFG = cfg_with("analysis.claims_resamples=40", "analysis.claims_fit_resamples=4")
 A, R = analysis_table, assay_table
@@ -548,6 +548,29 @@ def test_c6_without_a_planted_event_effect_is_weaker_with_a_proper_interval():
     parts = pd.DataFrame(part_rows("C6", assessed), columns=PART_COLUMNS)
     assert (parts["verdict"] == "weaker").all(), parts[["part", "verdict", "reason"]]
     assert ((parts["ci_low"] < 0) & (parts["ci_high"] > 0)).all(), parts[["part", "ci_low", "ci_high"]]
+
+
+def test_c5_and_c6_take_the_rate_that_wide2_recorded():
+    """Issue 38: C6's change of the EOD rate around an event is in Hz of the frame rate the wide2 assay recorded
+    (conditions.parquet), not of a config: agents that discharge on every step within 30 steps of an event and never
+    otherwise change their rate by exactly fps Hz, 83 at the default env.fps and 41.5 at half of it. C5's Kendall's
+    W ranks the rates, so it is the same at both; without the record neither claim runs."""
+    steps = wide_steps(False)
+    near = np.zeros(len(steps), bool)
+    for event in (150, 300, 450):
+        near |= (steps["t"] - event).abs().to_numpy() <= 30
+    steps = steps.assign(eod=near)
+    c5_effects = []
+    for fps in (DEFAULT_FPS, HALF_FPS):
+        tables = {R("wide2", "steps"): steps, R("wide2", "conditions"): recorded_table({"control": [f"env.fps={fps:g}"]})}
+        parts = {p.label: p for p in cl.CLAIMS["C6"].assess(tables, CFG)[1]}
+        for event in ("ate", "bit", "was_bitten"):
+            assert parts[event].effect == pytest.approx(fps), (event, parts[event].reason)
+        c5_effects.append([p.effect for p in cl.CLAIMS["C5"].assess(tables, CFG)[1]])
+    assert c5_effects[0] == c5_effects[1] and np.isfinite(c5_effects[0]).all()
+    for cid in ("C5", "C6"):
+        row = cl.CLAIMS[cid].run({R("wide2", "steps"): steps}, CFG)
+        assert row["verdict"] == "not run" and "assays/wide2/conditions.parquet" in row["reason"], row["reason"]
 
 
 def test_no_planted_effect_at_large_n_is_weaker_not_holds_nor_fails():
