@@ -82,9 +82,12 @@ def config_reference() -> str:
 
 
 def tables_reference() -> str:
-    """Markdown: the columns of every rollout table (``efish schema``) and of the claims tables."""
+    """Markdown: the columns of every rollout table (``efish schema``), of the analysis settings table and of the
+    claims tables."""
     from efish.analysis.selection import RANKING_COLUMNS
     from efish.claims.verdicts import PART_COLUMNS, ROW_COLUMNS
+    from efish.config.recorded import SETTINGS_COLUMN
+    from efish.layout import ANALYSIS_SETTINGS, analysis_settings
     from efish.rollout.schema import COLUMNS, HIDDEN_UNITS
 
     out = []
@@ -95,6 +98,13 @@ def tables_reference() -> str:
         if name == "hidden":
             out.append(f"| `h_0`, `h_1`, ... | `float` | {html.escape(HIDDEN_UNITS)} |")
         out.append("")
+    out += [f"## `{ANALYSIS_SETTINGS}.parquet`: the settings an analysis job ran with {{#analysis-settings}}", "",
+            f"`efish analyze` writes it beside the tables of every analysis of an assay "
+            f"(`{analysis_settings('<analysis>', '<assay>')}`): one row, whose `{SETTINGS_COLUMN}` column holds "
+            "the `analysis` config group the job ran with (every field, the run's overrides included) as JSON. "
+            "`efish.config.recorded.recorded_settings` reads it back; the panels read it for the thresholds they "
+            "name, which are those the tables were computed under. What the run simulated (frame rate, arena, "
+            "roles) is not in it: the analysis read that from the assay's `conditions.parquet`.", ""]
     for title, anchor, columns in (("`claims.parquet`: one row per claim", "claims", ROW_COLUMNS),
                                    ("`claim_parts.parquet`: one row per part of a claim", "claim-parts", PART_COLUMNS),
                                    ("`ranking.parquet`: the seed ranking", "ranking", RANKING_COLUMNS)):

@@ -121,8 +121,11 @@ def _parser() -> argparse.ArgumentParser:
     an = sub.add_parser("analyze", help="run one analysis (efish.analysis.registry) on an assay's rollout tables")
     an.add_argument("name", help="an analysis of efish.analysis.registry, e.g. behaviour (a wrong name lists them)")
     an.add_argument("overrides", nargs="*", help="config overrides, e.g. assay=patchy4 analysis.rate_bins=10")
-    an.add_argument("--tables", type=Path, required=True, help="folder of the assay's tables (steps.parquet, ...)")
-    an.add_argument("--out", type=Path, required=True, help="folder for <table>.parquet, config.yaml, provenance.json")
+    an.add_argument("--tables", type=Path, required=True,
+                    help="folder of the assay's tables (steps.parquet, ..., conditions.parquet: what it simulated)")
+    an.add_argument("--out", type=Path, required=True,
+                    help="folder for <table>.parquet, analysis_settings.parquet (the analysis settings it ran with), "
+                         "config.yaml, provenance.json")
     an.set_defaults(handler=_analyze)
     sc = sub.add_parser("scene", help="compute a scene's field maps (config/scene/<name>.yaml) into a table")
     sc.add_argument("name", help="a scene of config/scene/, e.g. eod_walls")

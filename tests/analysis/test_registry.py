@@ -8,7 +8,16 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from efish.analysis.registry import ANALYSES, ROLLOUT_TABLES, analyses_for, get, read_tables, run, tables_written
+from efish.analysis.registry import (
+    ANALYSES,
+    ROLLOUT_TABLES,
+    Analysis,
+    analyses_for,
+    get,
+    read_tables,
+    run,
+    tables_written,
+)
 from efish.analysis.stats import STAT_COLUMNS
 from efish.config import config_dir
 from efish.rollout.schema import SCHEMAS, to_table
@@ -184,6 +193,12 @@ def test_the_registry_names_spec_assays_rollout_tables_and_unique_outputs():
         assert set(a.stats) <= set(a.outputs) and len(set(a.outputs)) == len(a.outputs), a.name
         assert not set(a.outputs) & {*SCHEMAS, "hidden"}, a.name  # a rollout table's name means its schema
     assert shipped <= {s for a in ANALYSES.values() for s in a.assays}  # every shipped assay is analysed
+    for a in ANALYSES.values():  # every job reads the assay's record and writes the settings it ran with
+        assert "conditions" in a.reads and a.written == (*a.outputs, "analysis_settings"), a.name
+    with pytest.raises(ValueError, match="must read 'conditions'"):
+        Analysis("blind", lambda t, a, c: {}, ("steps",), ("patchy4",), ("x",))
+    with pytest.raises(ValueError, match="'analysis_settings' is the job's settings table"):
+        Analysis("clash", lambda t, a, c: {}, ("steps", "conditions"), ("patchy4",), ("analysis_settings",))
 
 
 def test_bad_names_and_missing_tables_are_one_line(tmp_path, tables):

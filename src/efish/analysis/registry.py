@@ -93,6 +93,13 @@ class Analysis:
     outputs: tuple[str, ...]
     stats: tuple[str, ...] = ()  # outputs that are statistic tables (STAT_COLUMNS)
 
+    def __post_init__(self):
+        if "conditions" not in self.reads:  # what the run simulated is read from its record, nowhere else
+            raise ValueError(f"analysis {self.name!r} must read 'conditions' (the assay's recorded conditions): "
+                             f"it reads {list(self.reads)}")
+        if ANALYSIS_SETTINGS in self.outputs:
+            raise ValueError(f"analysis {self.name!r}: {ANALYSIS_SETTINGS!r} is the job's settings table, no output")
+
     @property
     def written(self) -> tuple[str, ...]:
         """Every table its job writes: the :attr:`outputs`, then the analysis settings it ran with
