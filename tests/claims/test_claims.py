@@ -379,7 +379,7 @@ def wide_pair(flip: bool, episodes: int = 10, steps: int = 240) -> dict:
             frames.append(s)
             hidden.append(hidden_of(s, cols, units=8, seed=e * 2 + a))
     s, h = pd.concat(frames, ignore_index=True), pd.concat(hidden, ignore_index=True)
-    return {R("wide2", "steps"): s, R("wide2", "hidden"): h}
+    return {R("wide2", "steps"): s, R("wide2", "hidden"): h, R("wide2", "conditions"): recorded_table(("control",))}
 
 
 def c19(flip):

@@ -12,14 +12,14 @@ import dataclasses
 import numpy as np
 import pandas as pd
 
-from ..analysis._tables import AGENT_EPISODE
+from ..analysis._tables import AGENT_EPISODE, values_of
 from ..analysis.decoding import heldout_skill
 from ..analysis.dynamics import DECODE_TARGETS, plsc
 from ..analysis.dynamics_tests import groupsize_parts, smaller_larger
 from ..layout import analysis_table, assay_table
 from .context import Context, claim
 from .fig2 import HOMING_ELECTRIC, HOMING_STEPS
-from .fig3 import WIDE2_STEPS
+from .fig3 import WIDE2_CONDITIONS, WIDE2_STEPS
 from .intervals import smallest_p_signed_rank
 from .parts import joined, one_sample_part, paired_difference, per_episode, spearman_part
 from .statistics import interaction_slope, rho_of
@@ -89,7 +89,7 @@ FOOD_FEATURES = ("dist_food_cm", "bearing_food_rad")
 
 
 @claim("C19", "6E,F", "nearest-agent distance and Knollenorgan features decode best; food variables decode better "
-       "when food is in range", [WIDE2_HIDDEN, WIDE2_STEPS])
+       "when food is in range", [WIDE2_HIDDEN, WIDE2_STEPS, WIDE2_CONDITIONS])
 def c19(ctx: Context) -> list[Part]:
     folds = ctx.cfg.analysis.decode_folds
     near_cm = ctx.cfg.analysis.claims_food_near_cm
@@ -100,8 +100,11 @@ def c19(ctx: Context) -> list[Part]:
             raise ValueError(f"the wide2 steps table lacks the sensed variables {missing}: rerun the assay")
         j, h = joined(ctx, WIDE2_HIDDEN, WIDE2_STEPS, list(SENSED))
         # a step where no Mormyromast reads above E_min is recorded as NaN; the channel then delivers its floor
-        # (every normalised reading 0), so it is decoded as log10 E_min there: every variable on the same steps
-        j["log_morm_sensed"] = j["log_morm_sensed"].fillna(np.log10(ctx.cfg.sensors.mormyromast.e_min))
+        # (every normalised reading 0), so it is decoded as log10 E_min there (the condition's, as wide2 recorded
+        # it): every variable on the same steps
+        e_min = {c: cfg.sensors.mormyromast.e_min for c, cfg in ctx.recorded("wide2").items()}
+        floor = pd.Series(np.log10(values_of(e_min, j["condition"])), index=j.index)
+        j["log_morm_sensed"] = j["log_morm_sensed"].fillna(floor)
         j = j[np.isfinite(j[list(SENSED)].astype(np.float64)).all(axis=1)]
         skills = heldout_skill(j[h].to_numpy(), {c: (j[c].to_numpy(), SENSED[c]) for c in SENSED},
                                j["episode"].to_numpy(), folds)
