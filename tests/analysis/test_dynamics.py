@@ -63,7 +63,8 @@ def test_pcs_for_variance_on_a_known_spectrum():
                                            (np.ones((1, 4)), "need a T x D matrix")])
 def test_degenerate_hidden_states_give_nan_with_a_reason(h, reason):
     assert degenerate_reason(h).startswith(reason)
-    assert np.isnan(effective_dimensionality(h)) and np.isnan(pcs_for_variance(h)) and np.isnan(wideband_power(h, fs=FPS))
+    assert np.isnan(effective_dimensionality(h)) and np.isnan(pcs_for_variance(h))
+    assert np.isnan(wideband_power(h, fs=FPS))
 
 
 def test_constant_units_do_not_count():

@@ -562,7 +562,8 @@ def test_c5_and_c6_take_the_rate_that_wide2_recorded():
     steps = steps.assign(eod=near)
     c5_effects = []
     for fps in (DEFAULT_FPS, HALF_FPS):
-        tables = {R("wide2", "steps"): steps, R("wide2", "conditions"): recorded_table({"control": [f"env.fps={fps:g}"]})}
+        recorded = recorded_table({"control": [f"env.fps={fps:g}"]})
+        tables = {R("wide2", "steps"): steps, R("wide2", "conditions"): recorded}
         parts = {p.label: p for p in cl.CLAIMS["C6"].assess(tables, CFG)[1]}
         for event in ("ate", "bit", "was_bitten"):
             assert parts[event].effect == pytest.approx(fps), (event, parts[event].reason)

@@ -152,9 +152,8 @@ def _idi_tables(ids: pd.DataFrame, present: Iterable, a: AnalysisConfig, fps: Ma
     for (source, cond), x in _idi_samples(ids, present, a).items():
         keys = {"source": source, "condition": cond}
         discrete = source == "agents"
-        step_ms = 1000.0 / fps[cond] if discrete else 1.0
-        xmin = xmin_in_steps(a.xmin_ms, step_ms) if discrete else a.xmin_ms
-        scale = step_ms
+        scale = 1000.0 / fps[cond] if discrete else 1.0  # ms of one unit of x: a step of the condition, or 1 ms
+        xmin = xmin_in_steps(a.xmin_ms, scale) if discrete else a.xmin_ms
         extra = {"discrete": discrete, "xmin_steps": float(xmin) if discrete else np.nan}
         if isinstance(x, str):  # no sample: say why
             hist.append(nan_frame(x, **keys))
@@ -301,7 +300,8 @@ ANALYSES: dict[str, Analysis] = {a.name: a for a in [
              ("error_histogram", "error_vs_time", "trajectory_shape", "perception"), ("perception",)),
     Analysis("onepatch", _onepatch, ("steps", "conditions"), ("onepatch", "bot"),
              ("food_time_course", "reach_rates", "role_tests", "reach_tests"), ("role_tests", "reach_tests")),
-    Analysis("dynamics", _dynamics, ("hidden", "steps", "conditions"), ("patchy4", "wide2", "homing", "groupsize", "square2"),
+    Analysis("dynamics", _dynamics, ("hidden", "steps", "conditions"),
+             ("patchy4", "wide2", "homing", "groupsize", "square2"),
              ("dimensionality", "subsampling", "decoding", "food_decoding", "plsc", "plsc_collapse", "condition_tests",
               "size_tests", "power_near_far", "power_tests"), ("condition_tests", "size_tests", "power_tests")),
 ]}
