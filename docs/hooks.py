@@ -86,11 +86,14 @@ def _codes(columns) -> str:
 
 
 def tables_reference() -> str:
-    """Markdown: the columns of every rollout table (``efish schema``) and of the claims tables."""
+    """Markdown: the columns of every rollout table (``efish schema``), of the analysis settings table and of the
+    claims tables."""
     from efish.analysis.selection import RANKING_COLUMNS
     from efish.claims.recipe import RECIPE_COLUMNS, RECIPE_PART_COLUMNS
     from efish.claims.seeds import SEED_COLUMNS
     from efish.claims.verdicts import PART_COLUMNS, ROW_COLUMNS
+    from efish.config.recorded import SETTINGS_COLUMN
+    from efish.layout import ANALYSIS_SETTINGS, analysis_settings
     from efish.rollout.schema import COLUMNS, HIDDEN_UNITS
 
     out = []
@@ -101,6 +104,13 @@ def tables_reference() -> str:
         if name == "hidden":
             out.append(f"| `h_0`, `h_1`, ... | `float` | {html.escape(HIDDEN_UNITS)} |")
         out.append("")
+    out += [f"## `{ANALYSIS_SETTINGS}.parquet`: the settings an analysis job ran with {{#analysis-settings}}", "",
+            f"`efish analyze` writes it beside the tables of every analysis of an assay "
+            f"(`{analysis_settings('<analysis>', '<assay>')}`): one row, whose `{SETTINGS_COLUMN}` column holds "
+            "the `analysis` config group the job ran with (every field, the run's overrides included) as JSON. "
+            "`efish.config.recorded.recorded_settings` reads it back; the panels read it for the thresholds they "
+            "name, which are those the tables were computed under. What the run simulated (frame rate, arena, "
+            "roles) is not in it: the analysis read that from the assay's `conditions.parquet`.", ""]
     with_seeds = [*ROW_COLUMNS[:2], *RECIPE_COLUMNS, *ROW_COLUMNS[2:-1], *SEED_COLUMNS, ROW_COLUMNS[-1]]
     claims_note = (f"The pipeline's table (with the top seeds' verdicts and the recipe's): {_codes(with_seeds)}. "
                    "Meanings: [the claims page](../claims/index.md#what-a-row-holds).")

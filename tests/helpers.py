@@ -7,9 +7,10 @@ only holds fixtures. Configs are composed once per distinct override set
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import hashlib
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -17,6 +18,7 @@ import pandas as pd
 
 from efish import Snapshot
 from efish.config import compose
+from efish.config.schema import EnvConfig
 from efish.physics import Scene, build_plan
 from efish.rollout.assay import condition_configs
 from efish.rollout.conditions import conditions_table
@@ -30,6 +32,20 @@ def conditions_of(assay: str, *overrides: str) -> pd.DataFrame:
     """``assays/<assay>/conditions.parquet`` as efish assay records it at the smoke scale under ``overrides``
     (e.g. ``env.fps=25``): every condition's resolved config. Shared: copy before editing."""
     return conditions_table(condition_configs(["scale=smoke", *overrides, f"assay={assay}"]))
+
+
+def recorded_table(conditions: Iterable[str] | Mapping[str, Sequence[str]] = ("control", "treated"),
+                   *overrides: str) -> pd.DataFrame:
+    """``conditions.parquet`` as efish assay would record an assay of ``conditions`` (names, or name -> that
+    condition's own overrides, e.g. ``{"slow": ["env.fps=41.5"]}``) at the smoke scale under ``overrides``: the
+    record of synthetic rollout tables, whose condition names no assay file has. The first is the control."""
+    own = dict(conditions) if isinstance(conditions, Mapping) else {c: () for c in conditions}
+    listed = {name: [str(o) for o in extra] for name, extra in own.items()}
+    configs = {}
+    for name, extra in own.items():
+        cfg = cfg_with("scale=smoke", *overrides, *extra)
+        configs[name] = dataclasses.replace(cfg, assay=dataclasses.replace(cfg.assay, conditions=listed))
+    return conditions_table(configs)
 
 
 @functools.lru_cache(maxsize=None)
@@ -103,7 +119,8 @@ def rollout_tables(seed: int = 0, conditions=("control", "treated"), episodes: i
                    steps: int = 120, units: int = 8, bite_target: bool = True, error_angles: bool = False,
                    arena_cm: float = 70.0) -> dict:
     """Synthetic rollout tables with the columns of ``efish.rollout.schema`` (steps, episodes, food), a
-    ``hidden`` table keyed like steps (``h_0 .. h_{units-1}``) and, by choice, the columns the assays issue adds
+    ``hidden`` table keyed like steps (``h_0 .. h_{units-1}``), the ``conditions`` record of ``conditions`` at
+    the default settings (:func:`recorded_table`) and, by choice, the columns the assays issue adds
     (``bite_target``; ``err_*_rad``). Agents random-walk in the middle 30 cm so that pairs meet, bite and
     chase; bigger agents discharge and eat more, so that size effects exist."""
     import pandas as pd
@@ -126,7 +143,31 @@ def rollout_tables(seed: int = 0, conditions=("control", "treated"), episodes: i
     if error_angles:
         s = s.assign(**{c: rng.vonmises(0.0, 2.0, len(s)) for c in ("err_morm_rad", "err_amp_rad", "err_knollen_rad")})
     return {"steps": s, "episodes": _episodes_of(s), "food": pd.concat(food, ignore_index=True),
-            "hidden": pd.concat(hidden, ignore_index=True)}
+            "hidden": pd.concat(hidden, ignore_index=True), "conditions": recorded_table(conditions)}
+
+
+#: Steps per second of env.fps's default (83) and half of it: the frame rates of :func:`planted_rate_tables`.
+DEFAULT_FPS = float(EnvConfig().fps)
+HALF_FPS = DEFAULT_FPS / 2
+
+
+def planted_rate_tables(period: int = 5, leader_period: int | None = None, seed: int = 7) -> dict:
+    """Rollout tables of one assay with two conditions that hold the same steps and hidden states: ``default``,
+    recorded at env.fps's default (83), and ``slow``, recorded at half of it (its ``conditions`` record, as efish
+    assay writes it). Every agent discharges on every ``period``-th step (agent 0 on every ``leader_period``-th,
+    when given) and eats at steps 30, 60 and 90: a known EOD probability per step, 1 / period, so a known rate in
+    Hz, fps / period, at each condition's recorded rate."""
+    tables = rollout_tables(seed=seed, conditions=("default",), episodes=3, n_agents=4, steps=120)
+    steps = tables["steps"]
+    every = np.where(steps["agent"] == 0, leader_period or period, period)
+    steps = steps.assign(eod=steps["t"] % every == 0, ate=steps["t"].isin([30, 60, 90]))
+
+    def both(table: pd.DataFrame) -> pd.DataFrame:
+        return pd.concat([table, table.assign(condition="slow")], ignore_index=True)
+    steps = both(steps)
+    return {"steps": steps, "episodes": _episodes_of(steps), "food": both(tables["food"]),
+            "hidden": both(tables["hidden"]),
+            "conditions": recorded_table({"default": [], "slow": [f"env.fps={HALF_FPS:g}"]})}
 
 
 def _episode_steps(rng, cond: str, episode: int, n: int, steps: int, arena_cm: float):

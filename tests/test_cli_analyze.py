@@ -1,4 +1,5 @@
-"""``efish analyze``: tables, config.yaml and provenance.json, or one line and nothing written."""
+"""``efish analyze``: tables, the analysis settings it ran with, config.yaml and provenance.json, or one line and
+nothing written."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ import pytest
 
 from efish.analysis.registry import get
 from efish.cli import main
+from efish.config.recorded import recorded_settings
 
 from .helpers import rollout_tables
 
@@ -23,15 +25,18 @@ def assay_folder(tmp_path_factory):
 
 
 @pytest.mark.parametrize("name", ["behaviour", "dynamics"])
-def test_analyze_writes_tables_config_and_provenance(name, assay_folder, tmp_path, capsys):
+def test_analyze_writes_tables_settings_config_and_provenance(name, assay_folder, tmp_path, capsys):
     out = tmp_path / name
-    assert main(["analyze", name, "scale=smoke", "analysis.seed=3", "--tables", str(assay_folder),
-                 "--out", str(out)]) == 0
+    assert main(["analyze", name, "scale=smoke", "analysis.seed=3", "analysis.claims_near_cm=12.5",
+                 "--tables", str(assay_folder), "--out", str(out)]) == 0
     written = {p.name for p in out.iterdir()}
-    assert written == {f"{t}.parquet" for t in get(name).outputs} | {"config.yaml", "provenance.json"}
-    assert "seed: 3" in (out / "config.yaml").read_text()
+    assert written == {f"{t}.parquet" for t in get(name).written} | {"config.yaml", "provenance.json"}
+    assert "analysis_settings.parquet" in written and "seed: 3" in (out / "config.yaml").read_text()
+    settings = recorded_settings(pd.read_parquet(out / "analysis_settings.parquet"))
+    assert (settings.seed, settings.claims_near_cm) == (3, 12.5)  # the settings it ran with, overrides and all
     prov = json.loads((out / "provenance.json").read_text())
-    assert prov["analysis"] == name and prov["overrides"] == ["scale=smoke", "analysis.seed=3"]
+    assert prov["analysis"] == name and prov["overrides"] == ["scale=smoke", "analysis.seed=3",
+                                                              "analysis.claims_near_cm=12.5"]
     assert prov["tables"] == str(assay_folder)
     assert len(pd.read_parquet(out / f"{get(name).outputs[0]}.parquet")) > 0
     assert f"to {out}" in capsys.readouterr().out
@@ -53,7 +58,8 @@ def test_the_same_command_gives_the_same_tables(assay_folder, tmp_path):
 def test_bad_input_is_one_line_exit_2_and_nothing_written(args, message, assay_folder, tmp_path, capsys):
     tables = tmp_path / "tables"
     tables.mkdir()
-    pd.read_parquet(assay_folder / "steps.parquet").to_parquet(tables / "steps.parquet")  # no episodes table
+    for name in ("steps", "conditions"):  # no episodes table
+        (tables / f"{name}.parquet").write_bytes((assay_folder / f"{name}.parquet").read_bytes())
     out = tmp_path / "out"
     assert main(["analyze", *args, "--tables", str(tables), "--out", str(out)]) == 2
     err = capsys.readouterr().err.strip()

@@ -63,6 +63,7 @@ from .cli_claims import run_claims, run_claims_by_stage, run_compare_claims
 from .cli_support import run_of, write_metadata
 from .config import ConfigError, compose, to_yaml
 from .layout import (
+    ANALYSIS_SETTINGS,
     BENCH,
     CLAIMS_BY_STAGE,
     CLAIMS_BY_STAGE_FIGURE,
@@ -120,8 +121,11 @@ def _parser() -> argparse.ArgumentParser:
     an = sub.add_parser("analyze", help="run one analysis (efish.analysis.registry) on an assay's rollout tables")
     an.add_argument("name", help="an analysis of efish.analysis.registry, e.g. behaviour (a wrong name lists them)")
     an.add_argument("overrides", nargs="*", help="config overrides, e.g. assay=patchy4 analysis.rate_bins=10")
-    an.add_argument("--tables", type=Path, required=True, help="folder of the assay's tables (steps.parquet, ...)")
-    an.add_argument("--out", type=Path, required=True, help="folder for <table>.parquet, config.yaml, provenance.json")
+    an.add_argument("--tables", type=Path, required=True,
+                    help="folder of the assay's tables (steps.parquet, ..., conditions.parquet: what it simulated)")
+    an.add_argument("--out", type=Path, required=True,
+                    help="folder for <table>.parquet, analysis_settings.parquet (the analysis settings it ran with), "
+                         "config.yaml, provenance.json")
     an.set_defaults(handler=_analyze)
     sc = sub.add_parser("scene", help="compute a scene's field maps (config/scene/<name>.yaml) into a table")
     sc.add_argument("name", help="a scene of config/scene/, e.g. eod_walls")
@@ -368,13 +372,18 @@ def _stack_seeds(args, cfg, started) -> None:
 
 
 def _analyze(args, cfg, started) -> None:
+    """One analysis of an assay's record (its rollout tables and recorded conditions) under the analysis settings
+    of ``cfg``, which it writes beside the tables (``analysis_settings.parquet``) for the panels and claims."""
     from .analysis.registry import read_tables, run
+    from .config.recorded import settings_table
     from .io import write_parquet_tables
 
-    result = run(args.name, read_tables(args.name, args.tables), cfg)  # everything is read before anything is written
-    write_parquet_tables(result, args.out)
+    # everything is read before anything is written
+    result = run(args.name, read_tables(args.name, args.tables), cfg.analysis)
+    write_parquet_tables({**result, ANALYSIS_SETTINGS: settings_table(cfg.analysis)}, args.out)
     write_metadata(args.out, cfg, started, args, analysis=args.name, tables=str(args.tables))
-    print(f"wrote {', '.join(f'{k}.parquet ({len(v)} rows)' for k, v in result.items())} to {args.out}")
+    print(f"wrote {', '.join(f'{k}.parquet ({len(v)} rows)' for k, v in result.items())} and "
+          f"{ANALYSIS_SETTINGS}.parquet to {args.out}")
 
 
 def _scene(args, cfg, started) -> None:

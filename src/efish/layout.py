@@ -8,7 +8,7 @@ its tables under ``results/<run>/`` and its drawings under ``figures/<run>/``::
       selection/seed_N/               episodes, steps, food (held-out patchy episodes)
       analysis/selection/             ranking.parquet, selected_seed.txt
       assays/<assay>/                 steps, episodes, food, conditions (, hidden) .parquet
-      analysis/<analysis>/<assay>/    the tables of efish.analysis.registry
+      analysis/<analysis>/<assay>/    the tables of efish.analysis.registry, analysis_settings.parquet
       seeds/<assay>/episodes.parquet  the top seeds' episodes stacked (supplement)
       seeds/seed_N/                   another top seed's assays, analyses and claims, same layout
       learning/stage_K/               the same for the selected seed's K-th kept training stage
@@ -69,6 +69,16 @@ def analysis_folder(analysis: str, assay: str) -> str:
 def analysis_table(analysis: str, assay: str, table: str) -> str:
     """``analysis/<analysis>/<assay>/<table>.parquet``: a table of an analysis of one assay."""
     return f"{analysis_folder(analysis, assay)}/{table}.parquet"
+
+
+#: The table an analysis job writes beside its own: the analysis settings it ran with
+#: (:func:`efish.config.recorded.settings_table`); no analysis names an output so.
+ANALYSIS_SETTINGS = "analysis_settings"
+
+
+def analysis_settings(analysis: str, assay: str) -> str:
+    """``analysis/<analysis>/<assay>/analysis_settings.parquet``: the settings that analysis job ran with."""
+    return analysis_table(analysis, assay, ANALYSIS_SETTINGS)
 
 
 def training_folder(name: str) -> str:

@@ -223,8 +223,8 @@ def selected_seed(path: str | Path) -> int:
 
 # ------------------------------------------------------------------ outputs by name
 def analysis_outputs(analysis: Analysis, run: Run, assay: str = "{assay}") -> dict[str, str]:
-    """The tables ``analysis`` writes for ``assay`` in ``run``, by name."""
-    return {t: str(run.path(analysis_table(analysis.name, assay, t))) for t in analysis.outputs}
+    """The tables ``analysis`` writes for ``assay`` in ``run``, by name: its outputs and the settings it ran with."""
+    return {t: str(run.path(analysis_table(analysis.name, assay, t))) for t in analysis.written}
 
 
 def learning_outputs(run: Run) -> dict[str, str]:

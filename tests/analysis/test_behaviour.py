@@ -142,6 +142,10 @@ def test_the_patch_is_the_callers():
     assert reach_times(steps, (20.0, 20.0), 1.0)["reached"].tolist() == [True]
     assert reach_times(steps, (75.0, 75.0), 6.0)["reached"].tolist() == [False]
     assert reach_times(steps, (26.0, 20.0), 6.0)["reached"].tolist() == [True]  # at exactly the radius
+    # each condition's own arena, as it recorded it: the patch at (20, 20) in "c", at the centre of 150 cm in "big"
+    two = pd.concat([steps, steps.assign(condition="big")], ignore_index=True)
+    per = reach_times(two, ({"c": 20.0, "big": 75.0}, {"c": 20.0, "big": 75.0}), {"c": 1.0, "big": 6.0})
+    assert per.set_index("condition")["reached"].to_dict() == {"big": False, "c": True}
 
 
 def test_missing_columns_are_named():

@@ -23,6 +23,7 @@ from efish.analysis.dynamics import (
 )
 
 MODULES = ["signalling", "behaviour", "interactions", "homing", "stats", "dynamics", "decoding"]
+FPS = 83.0  # steps per second (env.fps's default)
 
 
 def test_analysis_modules_load_neither_numba_nor_torch():
@@ -54,7 +55,8 @@ def test_pcs_for_variance_on_a_known_spectrum():
                                            (np.ones((1, 4)), "need a T x D matrix")])
 def test_degenerate_hidden_states_give_nan_with_a_reason(h, reason):
     assert degenerate_reason(h).startswith(reason)
-    assert np.isnan(effective_dimensionality(h)) and np.isnan(pcs_for_variance(h)) and np.isnan(wideband_power(h))
+    assert np.isnan(effective_dimensionality(h)) and np.isnan(pcs_for_variance(h))
+    assert np.isnan(wideband_power(h, fs=FPS))
 
 
 def test_constant_units_do_not_count():
@@ -95,11 +97,12 @@ def test_plsc_degenerate():
         plsc(rng.normal(size=(100, 4)), rng.normal(size=(90, 4)))
 
 
-def test_wideband_power_scales_with_variance():
+def test_wideband_power_scales_with_variance_and_is_per_hz_of_the_step_rate():
     rng = np.random.default_rng(0)
     h = rng.normal(size=(400, 6))
-    assert wideband_power(2 * h) == pytest.approx(4 * wideband_power(h))
-    assert np.isnan(wideband_power(h[:19]))  # shorter than one 20-step window
+    assert wideband_power(2 * h, fs=FPS) == pytest.approx(4 * wideband_power(h, fs=FPS))
+    assert wideband_power(h, fs=FPS / 2) == pytest.approx(2 * wideband_power(h, fs=FPS))  # a density per Hz
+    assert np.isnan(wideband_power(h[:19], fs=FPS))  # shorter than one 20-step window
 
 
 def test_hidden_frame_helpers():
@@ -113,7 +116,7 @@ def test_hidden_frame_helpers():
     shuffled = hidden.sample(frac=1.0, random_state=0)
     mine = hidden_matrix(shuffled[shuffled["agent"] == 0])
     np.testing.assert_array_equal(mine, hidden[hidden["agent"] == 0][[f"h_{i}" for i in range(12)]].to_numpy())
-    table = dynamics_table(shuffled).set_index("agent")
+    table = dynamics_table(shuffled, fps=FPS).set_index("agent")
     assert table.loc[0, "d_eff"] > 5 and table.loc[0, "reason"] == ""
     assert np.isnan(table.loc[1, "d_eff"]) and table.loc[1, "reason"] == "no unit varies"
     with pytest.raises(ValueError, match="h_<i>"):

@@ -17,7 +17,8 @@ from efish.analysis.signalling import (
     xmin_in_steps,
 )
 
-STEP_MS = 1000.0 / 83.0
+FPS = 83.0  # steps per second the synthetic agents were simulated at (env.fps's default)
+STEP_MS = 1000.0 / FPS
 
 
 def agent_steps(eod, agent=0, episode=0, **columns) -> pd.DataFrame:
@@ -31,10 +32,15 @@ def agent_steps(eod, agent=0, episode=0, **columns) -> pd.DataFrame:
 
 def test_idis_are_step_differences_per_agent_episode():
     steps = pd.concat([agent_steps([1, 0, 0, 1, 1, 0]), agent_steps([0, 1, 0, 0, 0, 1], agent=1)])
-    out = idis(steps.sample(frac=1.0, random_state=0))  # row order must not matter
+    out = idis(steps.sample(frac=1.0, random_state=0), fps=FPS)  # row order must not matter
     assert out["idi_steps"].tolist() == [3, 1, 4] and out["agent"].tolist() == [0, 0, 1]
     np.testing.assert_allclose(out["idi_ms"], np.array([3, 1, 4]) * STEP_MS)
-    assert idis(agent_steps([0, 0, 1])).empty
+    assert idis(agent_steps([0, 0, 1]), fps=FPS).empty
+    # per condition: each condition's IDIs in its own ms
+    two = pd.concat([agent_steps([1, 0, 1]), agent_steps([1, 0, 1]).assign(condition="slow")])
+    assert idis(two, fps={"c": 100.0, "slow": 50.0})["idi_ms"].tolist() == [20.0, 40.0]
+    with pytest.raises(ValueError, match="no recorded value for condition 'slow'"):
+        idis(two, fps={"c": 100.0})
 
 
 def test_power_law_alpha_recovered_on_1e4_samples():
@@ -55,7 +61,7 @@ def test_discrete_power_law_of_whole_steps():
     assert abs(fit["alpha"] - 2.5) < 0.1 and fit["R_exponential"] > 0 and fit["p_exponential"] < 0.05
     geometric = fit_power_law(np.random.default_rng(2).geometric(0.3, 20_000), 1, discrete=True)
     assert geometric["R_exponential"] < 0 and geometric["p_exponential"] < 0.05
-    assert xmin_in_steps(12.0, 12.048) == 1 and xmin_in_steps(24.1, 12.048) == 3 and xmin_in_steps(0.0) == 1
+    assert xmin_in_steps(12.0, 12.048) == 1 and xmin_in_steps(24.1, 12.048) == 3 and xmin_in_steps(0.0, 12.048) == 1
 
 
 def test_fewer_alternatives_change_no_comparison():
@@ -96,7 +102,7 @@ def test_eod_rate_by_distance_bins_mean_and_drops_sparse_bins():
     dist[200:230] = np.nan                          # no food in sight while the rate window changes over
     dist[300:303] = 5.0                             # three samples in a middle bin: dropped (< 5)
     steps = agent_steps(np.arange(t) < 215, dist_food_cm=dist)  # fires while near (and a bit after)
-    out = eod_rate_by_distance(steps, "food")
+    out = eod_rate_by_distance(steps, "food", fps=FPS)
     assert out["bin"].tolist() == [1, 13] and (out["reason"] == "").all()
     assert out["mean_hz"].tolist() == pytest.approx([83.0, 0.0])
     assert out.loc[0, "bin_lo_cm"] == pytest.approx(2 / 3) and out.loc[0, "n"] == 200 - 10  # full windows only
@@ -104,13 +110,13 @@ def test_eod_rate_by_distance_bins_mean_and_drops_sparse_bins():
 
 
 def test_eod_rate_by_distance_degenerate_and_errors():
-    far = eod_rate_by_distance(agent_steps(np.ones(50), dist_food_cm=np.nan), "food")
+    far = eod_rate_by_distance(agent_steps(np.ones(50), dist_food_cm=np.nan), "food", fps=FPS)
     assert len(far) == 1 and np.isnan(far.loc[0, "mean_hz"]) and "no distance bin" in far.loc[0, "reason"]
-    assert eod_rate_by_distance(agent_steps([]), "wall").loc[0, "reason"] == "empty steps table"
+    assert eod_rate_by_distance(agent_steps([]), "wall", fps=FPS).loc[0, "reason"] == "empty steps table"
     with pytest.raises(ValueError, match="to must be one of"):
-        eod_rate_by_distance(agent_steps(np.ones(50)), "pellet")
+        eod_rate_by_distance(agent_steps(np.ones(50)), "pellet", fps=FPS)
     with pytest.raises(ValueError, match="dist_agent_cm"):
-        eod_rate_by_distance(agent_steps(np.ones(50)).drop(columns="dist_agent_cm"), "agent")
+        eod_rate_by_distance(agent_steps(np.ones(50)).drop(columns="dist_agent_cm"), "agent", fps=FPS)
 
 
 def test_peri_event_rate_rises_after_events():
@@ -119,7 +125,7 @@ def test_peri_event_rate_rises_after_events():
     for e in events:
         ate[e] = True
         eod[e:e + 40] = True  # fires for 40 steps after eating
-    out = peri_event_rate(agent_steps(eod, ate=ate), "ate").set_index("lag")
+    out = peri_event_rate(agent_steps(eod, ate=ate), "ate", fps=FPS).set_index("lag")
     assert out.loc[20, "mean_hz"] == pytest.approx(83.0) and out.loc[-50, "mean_hz"] == 0.0
     assert (out["n_agents"] == 1).all() and out["sem_hz"].isna().all()  # one agent-episode: no SEM
     assert len(out) == 201 and out.loc[-100, "lag_ms"] == pytest.approx(-100 * STEP_MS)
@@ -128,19 +134,19 @@ def test_peri_event_rate_rises_after_events():
 def test_peri_event_rate_needs_enough_events():
     ate = np.zeros(300, bool)
     ate[[50, 150]] = True
-    out = peri_event_rate(agent_steps(np.ones(300), ate=ate), "ate")
+    out = peri_event_rate(agent_steps(np.ones(300), ate=ate), "ate", fps=FPS)
     assert len(out) == 1 and np.isnan(out.loc[0, "mean_hz"]) and "3 or more 'ate' events" in out.loc[0, "reason"]
     with pytest.raises(ValueError, match="event must be one of"):
-        peri_event_rate(agent_steps(np.ones(300)), "eaten")
+        peri_event_rate(agent_steps(np.ones(300)), "eaten", fps=FPS)
 
 
 def test_rate_advantage_of_a_close_pair():
     on, off = np.ones(100), np.zeros(100)
     steps = pd.concat([agent_steps(on, size=0.8), agent_steps(off, agent=1, size=0.3, x_cm=15.0)])
-    out = rate_advantage_vs_size(steps)
+    out = rate_advantage_vs_size(steps, fps=FPS)
     assert len(out) == 1 and out.loc[0, "size_advantage"] == pytest.approx(0.5)
     assert out.loc[0, "rate_advantage_hz"] == pytest.approx(83.0) and out.loc[0, "n_steps"] == 100 - 19
-    far = rate_advantage_vs_size(steps.assign(x_cm=np.r_[np.full(100, 10.0), np.full(100, 90.0)]))
+    far = rate_advantage_vs_size(steps.assign(x_cm=np.r_[np.full(100, 10.0), np.full(100, 90.0)]), fps=FPS)
     assert np.isnan(far.loc[0, "rate_advantage_hz"]) and "within 10.0 cm" in far.loc[0, "reason"]
 
 

@@ -34,7 +34,7 @@ from efish.cli import main
 from efish.config.recorded import recorded_conditions
 from efish.layout import analysis_table, assay_table
 
-from ..helpers import REPO, cfg_with, conditions_of, rollout_tables
+from ..helpers import DEFAULT_FPS, HALF_FPS, REPO, cfg_with, conditions_of, recorded_table, rollout_tables
 
 CFG = cfg_with("analysis.claims_resamples=40", "analysis.claims_fit_resamples=4")
 A, R = analysis_table, assay_table
@@ -142,7 +142,7 @@ def wide_steps(flip: bool, episodes: int = 8, steps: int = 600, null: bool = Fal
 
 
 def c5(flip):
-    return {R("wide2", "steps"): wide_steps(flip)}
+    return {R("wide2", "steps"): wide_steps(flip), R("wide2", "conditions"): recorded_table(("control",))}
 
 
 c6 = c5
@@ -394,7 +394,7 @@ def wide_pair(flip: bool, episodes: int = 10, steps: int = 240) -> dict:
             frames.append(s)
             hidden.append(hidden_of(s, cols, units=8, seed=e * 2 + a))
     s, h = pd.concat(frames, ignore_index=True), pd.concat(hidden, ignore_index=True)
-    return {R("wide2", "steps"): s, R("wide2", "hidden"): h}
+    return {R("wide2", "steps"): s, R("wide2", "hidden"): h, R("wide2", "conditions"): recorded_table(("control",))}
 
 
 def c19(flip):
@@ -560,10 +560,34 @@ def test_the_authors_self_only_mode_is_reported_beside_and_does_not_decide():
 
 def test_c6_without_a_planted_event_effect_is_weaker_with_a_proper_interval():
     """EOD probability unrelated to the events: no part holds or fails, and each interval spans 0 with a width."""
-    _, assessed = cl.CLAIMS["C6"].assess({R("wide2", "steps"): wide_steps(False, null=True)}, CFG)
+    _, assessed = cl.CLAIMS["C6"].assess({**c6(False), R("wide2", "steps"): wide_steps(False, null=True)}, CFG)
     parts = pd.DataFrame(part_rows("C6", assessed), columns=PART_COLUMNS)
     assert (parts["verdict"] == "weaker").all(), parts[["part", "verdict", "reason"]]
     assert ((parts["ci_low"] < 0) & (parts["ci_high"] > 0)).all(), parts[["part", "ci_low", "ci_high"]]
+
+
+def test_c5_and_c6_take_the_rate_that_wide2_recorded():
+    """Issue 38: C6's change of the EOD rate around an event is in Hz of the frame rate the wide2 assay recorded
+    (conditions.parquet), not of a config: agents that discharge on every step within 30 steps of an event and never
+    otherwise change their rate by exactly fps Hz, 83 at the default env.fps and 41.5 at half of it. C5's Kendall's
+    W ranks the rates, so it is the same at both; without the record neither claim runs."""
+    steps = wide_steps(False)
+    near = np.zeros(len(steps), bool)
+    for event in (150, 300, 450):
+        near |= (steps["t"] - event).abs().to_numpy() <= 30
+    steps = steps.assign(eod=near)
+    c5_effects = []
+    for fps in (DEFAULT_FPS, HALF_FPS):
+        recorded = recorded_table({"control": [f"env.fps={fps:g}"]})
+        tables = {R("wide2", "steps"): steps, R("wide2", "conditions"): recorded}
+        parts = {p.label: p for p in cl.CLAIMS["C6"].assess(tables, CFG)[1]}
+        for event in ("ate", "bit", "was_bitten"):
+            assert parts[event].effect == pytest.approx(fps), (event, parts[event].reason)
+        c5_effects.append([p.effect for p in cl.CLAIMS["C5"].assess(tables, CFG)[1]])
+    assert c5_effects[0] == c5_effects[1] and np.isfinite(c5_effects[0]).all()
+    for cid in ("C5", "C6"):
+        row = cl.CLAIMS[cid].run({R("wide2", "steps"): steps}, CFG)
+        assert row["verdict"] == "not run" and "assays/wide2/conditions.parquet" in row["reason"], row["reason"]
 
 
 def test_no_planted_effect_at_large_n_is_weaker_not_holds_nor_fails():
@@ -746,7 +770,7 @@ def results(tmp_path_factory):
         for name in ("steps", "episodes"):
             (root / "assays" / assay).mkdir(parents=True, exist_ok=True)
             tables[name].to_parquet(root / "assays" / assay / f"{name}.parquet")
-        out = run("behaviour", tables, cfg)
+        out = run("behaviour", tables, cfg.analysis)
         (root / "analysis" / "behaviour" / assay).mkdir(parents=True)
         for name, table in out.items():
             table.to_parquet(root / "analysis" / "behaviour" / assay / f"{name}.parquet")

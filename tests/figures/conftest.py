@@ -1,7 +1,8 @@
 """A results folder of synthetic tables shaped like a real run's: every assay of the laptop scale gets
 rollout tables from ``tests.helpers.rollout_tables`` with its own conditions and agent count, and the
 ``conditions.parquet`` efish assay records (:func:`conditions_of`), and every analysis of it runs for real on
-them (``efish.analysis.registry.run``), so panels are drawn from the same table shapes the pipeline writes."""
+them (``efish.analysis.registry.run``) and records its settings as efish analyze does, so panels are drawn from
+the same table shapes the pipeline writes."""
 
 from __future__ import annotations
 
@@ -10,12 +11,14 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from tests.helpers import conditions_of, rollout_tables
+from tests.helpers import cfg_with, conditions_of, rollout_tables
 
 from efish.analysis.registry import analyses_for, run, tables_written
 from efish.analysis.selection import rank_seeds, seed_statistics, stack_top_seeds
 from efish.config import compose
-from efish.figures.panel import conditions_key
+from efish.config.recorded import settings_table
+from efish.figures.panel import conditions_key, settings_key
+from efish.layout import ANALYSIS_SETTINGS
 from efish.rollout.tables import write_tables
 
 SEEDS = 2
@@ -51,6 +54,16 @@ def recorded():
 
 
 @pytest.fixture(scope="session")
+def analysed():
+    """``analysed("dynamics", "wide2", overrides=[...])``: the settings table an analysis job records, keyed like
+    :attr:`efish.figures.panel.Panel.settings`, for the analysis settings under ``overrides``."""
+    def tables(analysis: str, *assays: str, overrides=()) -> dict[str, pd.DataFrame]:
+        return {settings_key(analysis, a): settings_table(cfg_with(*overrides).analysis) for a in assays}
+
+    return tables
+
+
+@pytest.fixture(scope="session")
 def synthetic_results(tmp_path_factory) -> Path:
     """``results/{run}``-shaped folder: assays/<assay>/*.parquet, analysis/<analysis>/<assay>/*.parquet,
     train/seed_<n>/metrics.parquet, analysis/selection/ranking.parquet and the top seeds' assays."""
@@ -60,7 +73,8 @@ def synthetic_results(tmp_path_factory) -> Path:
         tables, cfg = _assay_tables(assay, seed=i)
         _write(tables, root / "assays" / assay)
         for analysis in analyses_for(assay, tables):
-            _write(run(analysis.name, tables, cfg), root / "analysis" / analysis.name / assay)
+            _write({**run(analysis.name, tables, cfg.analysis), ANALYSIS_SETTINGS: settings_table(cfg.analysis)},
+                   root / "analysis" / analysis.name / assay)
     episodes = []
     for seed in range(1, SEEDS + 1):
         rng = np.random.default_rng(seed)

@@ -9,12 +9,16 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from efish.analysis.registry import run
 from efish.analysis.stats import STAT_COLUMNS
 from efish.config import compose
 from efish.figures import fig3
+from efish.figures.panel import conditions_key
 from efish.figures.registry import PANELS
 from efish.figures.render import load_tables, render_panel
 from efish.figures.style import panel_style
+
+from ..helpers import DEFAULT_FPS, HALF_FPS, cfg_with, planted_rate_tables
 
 KEYS = [p.key for p in fig3.PANELS]
 
@@ -163,6 +167,36 @@ def test_rates_and_arena_follow_the_frame_rate_and_arena_the_run_recorded(tables
     assert top == pytest.approx(25.0 * probability.max(), rel=1e-6)
     with drawn("fig3/B", {**tables["fig3/B"], **overridden}) as ax:
         assert (ax.get_xlim(), ax.get_ylim()) == ((0, 90), (0, 80))
+
+
+def test_rates_are_drawn_in_the_hz_each_condition_recorded():
+    """Issue 38: an assay with one condition at half the default env.fps. Agents that discharge on every 5th step
+    are drawn at fps / 5 Hz: 16.6 for the default condition, 8.3 for the slow one, on panel E (rate vs distance)
+    and panel H (around eating, whose time axis is in each condition's ms); panel O's Hz are each condition's EOD
+    probability (0.2) times its own recorded rate."""
+    planted, settings = planted_rate_tables(period=5), cfg_with("scale=smoke").analysis
+    fps = {"default": DEFAULT_FPS, "slow": HALF_FPS}
+    signalling, behaviour = run("signalling", planted, settings), run("behaviour", planted, settings)
+    with drawn("fig3/E", {"rate_by_distance": signalling["rate_by_distance"]}) as ax:
+        lines = {line.get_label(): line for line in ax.get_lines()}
+    with drawn("fig3/H", {"peri_event": signalling["peri_event"]}) as ax:
+        curves = {line.get_label(): line for line in ax.get_lines() if line.get_label() in fps}
+    reach = {}  # the last lag drawn, in steps
+    for condition, rate in fps.items():
+        assert lines[condition].get_ydata() == pytest.approx(rate / 5)
+        y, x = curves[condition].get_ydata(), curves[condition].get_xdata()
+        assert y[np.isfinite(y)] == pytest.approx(rate / 5)
+        lags = np.asarray(x, float) * rate / 1000.0
+        assert lags == pytest.approx(np.round(lags))  # whole steps of the condition's own duration
+        reach[condition] = round(lags.max())
+    assert reach["default"] == reach["slow"] > 0
+    recorded = {conditions_key("patchy4"): planted["conditions"]}
+    with drawn("fig3/O", {"eod_probability": behaviour["eod_probability"], "size_tests": behaviour["size_tests"],
+                          **recorded}) as ax:
+        drawn_hz = {c.get_label(): np.asarray(c.get_offsets()[:, 1], float) for c in ax.collections}
+    assert set(drawn_hz) == set(fps)
+    for condition, rate in fps.items():
+        assert drawn_hz[condition] == pytest.approx(0.2 * rate)
 
 
 def test_theil_panel_reads_its_test_when_the_table_holds_one(tables):

@@ -68,16 +68,17 @@ def test_decoding_without_any_skill_says_why(recorded):
     assert any("constant target" in t for t in texts(ax))
 
 
-def test_food_decoding_bars_pair_near_and_far_skills_per_variable(recorded):
+def test_food_decoding_bars_pair_near_and_far_skills_per_variable(recorded, analysed):
     table = pd.DataFrame({"condition": "control", "food": ["near", "near", "far", "far"],
                           "target": ["dist_food_cm", "bearing_food_rad"] * 2, "skill": [0.5, 0.3, -0.05, np.nan],
                           "reason": ["", "", "", "fewer than 2 groups (episodes) with finite rows (1)"]})
-    ax = draw("fig6/F", {"food_decoding": table, **recorded("wide2")})
+    wide2 = {**recorded("wide2"), **analysed("dynamics", "wide2")}
+    ax = draw("fig6/F", {"food_decoding": table, **wide2})
     widths = sorted(p.get_width() for p in ax.patches if p.get_height() > 0 and np.isfinite(p.get_width()))
     np.testing.assert_allclose(widths, [-0.05, 0.3, 0.5])
     assert {t.get_text() for t in ax.get_yticklabels()} == {"food: distance", "food: bearing"}
     assert [t.get_text() for t in ax.get_legend().get_texts()] == ["near", "far"]
-    empty = draw("fig6/F", {"food_decoding": table.assign(skill=np.nan), **recorded("wide2")})
+    empty = draw("fig6/F", {"food_decoding": table.assign(skill=np.nan), **wide2})
     assert any("fewer than 2 groups" in t for t in texts(empty))
 
 
@@ -125,11 +126,11 @@ def test_deff_vs_group_size_means_per_knollenorgan_state():
     np.testing.assert_allclose(means["K off"], [1.0, 1.5])
 
 
-def test_power_near_far_draws_each_agent_episode_and_the_wilcoxon_stars(recorded):
+def test_power_near_far_draws_each_agent_episode_and_the_wilcoxon_stars(recorded, analysed):
     power = pd.DataFrame({"condition": "control", "episode": [0, 0, 1, 1], "agent": 0,
                           "where": ["near", "far"] * 2, "wideband_power": [1.0, 3.0, 2.0, 5.0], "reason": ""})
     tests = pd.DataFrame({"measure": ["near_far", "size"], "stars": ["XNEAR", "XSIZE"]})
-    wide2 = recorded("wide2")
+    wide2 = {**recorded("wide2"), **analysed("dynamics", "wide2")}
     ax = draw("fig6/I", {"power": power, "tests": tests, **wide2})
     by_x = {}
     for c in ax.collections:
@@ -147,11 +148,14 @@ def test_power_near_far_draws_each_agent_episode_and_the_wilcoxon_stars(recorded
     assert any("lacks x" in t for t in texts(ax))
 
 
-def test_thresholds_named_on_the_panels_are_the_runs(recorded):
-    """The near / far distances on panel I's ticks and panel F's legend are the analysis settings the run
-    recorded, not the schema's defaults."""
-    wide2 = recorded("wide2", overrides=("analysis.claims_near_cm=7", "analysis.claims_far_cm=45",
-                                         "analysis.claims_food_near_cm=3"))
+def test_thresholds_named_on_the_panels_are_the_analysis_jobs(recorded, analysed):
+    """The near / far distances on panel I's ticks and panel F's legend, and panel A's variance fraction, are the
+    analysis settings the dynamics job recorded beside its tables (analysis_settings.parquet): not the schema's
+    defaults, nor the analysis settings the assay's conditions happen to hold."""
+    wide2 = {**recorded("wide2", overrides=("analysis.claims_near_cm=9", "analysis.claims_far_cm=99",
+                                            "analysis.claims_food_near_cm=1")),
+             **analysed("dynamics", "wide2", overrides=("analysis.claims_near_cm=7", "analysis.claims_far_cm=45",
+                                                        "analysis.claims_food_near_cm=3"))}
     power = pd.DataFrame({"condition": "control", "episode": [0, 0], "agent": 0, "where": ["near", "far"],
                           "wideband_power": [1.0, 3.0], "reason": ""})
     ax = draw("fig6/I", {"power": power, "tests": pd.DataFrame({"measure": ["near_far"], "stars": ["*"]}), **wide2})
@@ -160,3 +164,15 @@ def test_thresholds_named_on_the_panels_are_the_runs(recorded):
                           "skill": [0.5, 0.1], "reason": ""})
     ax = draw("fig6/F", {"food_decoding": table, **wide2})
     assert ax.get_legend().get_title().get_text() == "food (near: <= 3 cm)"
+    dims = pd.DataFrame({"condition": "control", "episode": [0, 1], "agent": 0, "d_eff": [3.0, 4.0],
+                         "pcs_for_variance": [5, 6]})
+    ax = draw("fig6/A", {"dims": dims, **recorded("patchy4"),
+                         **analysed("dynamics", "patchy4", overrides=("analysis.variance_fraction=0.8",))})
+    assert [t.get_text() for t in ax.get_xticklabels()] == ["D_eff", "PCs for 80% var."]
+
+
+def test_a_panel_reads_the_settings_of_the_analysis_jobs_whose_tables_it_names():
+    """Panel I reads two dynamics tables of wide2: one settings table beside them, which the job writes."""
+    panel = PANELS["fig6/I"]
+    assert panel.settings == {"settings/dynamics/wide2": "analysis/dynamics/wide2/analysis_settings.parquet"}
+    assert set(panel.settings.items()) <= set(panel.tables.items())

@@ -72,9 +72,12 @@ def test_panels_read_the_conditions_of_every_assay_they_read(tmp_path):
     assert set(PANELS["fig3/P"].conditions) == {"conditions/patchy4"}
     assert set(PANELS["supp/idi_histogram"].conditions) == {"conditions/patchy4", "conditions/wide2"}
     for key in ("fig1/A", "supp/training_curves", "supp/top_seeds_food"):  # schematic, training, top seeds: none
-        assert not PANELS[key].conditions and PANELS[key].tables == PANELS[key].inputs
+        assert not PANELS[key].conditions and not PANELS[key].settings and PANELS[key].tables == PANELS[key].inputs
+    assert PANELS["fig5/I"].settings == {"settings/onepatch/bot": "analysis/onepatch/bot/analysis_settings.parquet"}
     for panel in PANELS.values():
-        assert set(panel.tables) == set(panel.inputs) | {f"conditions/{a}" for a in panel.assays()}
+        jobs = {(t.analysis, t.assay) for p in panel.inputs.values() if (t := layout.parse_table(p)) and t.analysis}
+        assert set(panel.tables) == (set(panel.inputs) | {f"conditions/{a}" for a in panel.assays()}
+                                     | {f"settings/{analysis}/{assay}" for analysis, assay in jobs})
 
 
 def test_a_missing_conditions_table_says_to_rerun_the_assay(synthetic_results, tmp_path):
@@ -84,6 +87,16 @@ def test_a_missing_conditions_table_says_to_rerun_the_assay(synthetic_results, t
         (results / name).write_bytes((synthetic_results / name).read_bytes())
     with pytest.raises(ValueError, match=r"needs .*assays/patchy4/conditions\.parquet.*rerun the assay"):
         load_tables(PANELS["fig3/O"], results, seeds=2)
+
+
+def test_a_missing_settings_table_says_to_rerun_the_analysis(synthetic_results, tmp_path):
+    panel, results = PANELS["fig6/I"], tmp_path / "results"
+    for name in [*panel.inputs.values(), *panel.conditions.values()]:
+        (results / name).parent.mkdir(parents=True, exist_ok=True)
+        (results / name).write_bytes((synthetic_results / name).read_bytes())
+    with pytest.raises(ValueError, match=r"needs .*analysis/dynamics/wide2/analysis_settings\.parquet.*rerun the "
+                                         r"analysis"):
+        load_tables(panel, results, seeds=2)
 
 
 def test_seed_paths_expand_over_every_seed(tmp_path):

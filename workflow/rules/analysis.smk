@@ -1,5 +1,7 @@
-# Analyses: one rule per analysis of efish.analysis.registry, one job per (analysis, assay), writing the tables the
-# registry declares (efish.layout.analysis_table). The DAG asks for the analyses of each assay of the scale whose
+# Analyses: one rule per analysis of efish.analysis.registry, one job per (analysis, assay), reading the assay's
+# record (its rollout tables and conditions.parquet) and writing the tables the registry declares
+# (efish.layout.analysis_table) and the analysis settings it ran with (analysis_settings.parquet, which the
+# panels read; Analysis.written). The DAG asks for the analyses of each assay of the scale whose
 # input tables that assay writes (efish.run_plan: RunPlan.assay_analyses). The same rule per analysis, named
 # top_seed_analysis_<analysis>, runs on a top seed's rerun assays in its copy of the layout (the analyses the
 # claims read there; RunPlan.seed_analysis_assays), and stage_analysis_<analysis> on a training stage's

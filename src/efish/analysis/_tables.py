@@ -1,4 +1,5 @@
-"""Shared helpers of the analysis modules: column checks, keys, angles, per-agent rates, step pairs.
+"""Shared helpers of the analysis modules: column checks, keys, angles, per-agent rates, step pairs, values per
+condition.
 
 Private: the analysis modules import these so that a check or a pairing is
 written once.
@@ -6,20 +7,21 @@ written once.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 
 import numpy as np
 import pandas as pd
 
-from ..config.schema import AnalysisConfig, EnvConfig
+from ..config.schema import AnalysisConfig
 
 #: The schema's analysis parameters (docs/methods/analyses.md): the keyword defaults of the analysis functions, so that
-#: a function called by hand and ``efish analyze`` (which passes the composed config's values) agree.
+#: a function called by hand and ``efish analyze`` (which passes the analysis settings it runs with) agree.
 DEFAULTS = AnalysisConfig()
-#: Steps per second (``env.fps``, 83), the factor from an EOD probability per step to a rate in Hz.
-RATE_HZ = EnvConfig().fps
-#: ms per simulation step: dt = 1 / fps (docs/model/environment.md#step-order), i.e. 12.048 ms.
-STEP_MS = 1000.0 / RATE_HZ
+#: A quantity of the simulation that each condition records (its ``env.fps``, its arena): one number for every row,
+#: or condition -> its number (``efish analyze`` passes the assay's recorded conditions this way,
+#: :func:`efish.config.recorded.step_rates`). There is no default: a rate in Hz or ms per step is the run's, so the
+#: caller names it.
+PerCondition = float | Mapping[str, float]
 
 EPISODE = ["condition", "episode"]
 AGENT_EPISODE = ["condition", "episode", "agent"]
@@ -43,9 +45,29 @@ def or_nan_row(frame: pd.DataFrame, reason: str) -> pd.DataFrame:
     return nan_frame(reason).reindex(columns=list(dict.fromkeys([*frame.columns, "reason"])))
 
 
-def eod_rate(steps: pd.DataFrame, window: int = DEFAULTS.rate_window, rate_hz: float = RATE_HZ) -> np.ndarray:
-    """Centred rolling mean of ``eod`` over ``window`` steps x ``rate_hz`` per agent-episode
-    (docs/methods/analyses.md#analysis-signalling), in Hz.
+def value_of(value: PerCondition, condition) -> float:
+    """``value`` itself, or its entry for ``condition`` (:data:`PerCondition`); a condition it lacks is one
+    ValueError naming it."""
+    if not isinstance(value, Mapping):
+        return value
+    if condition not in value:
+        raise ValueError(f"no recorded value for condition {condition!r} (recorded: {', '.join(map(str, value))})")
+    return value[condition]
+
+
+def values_of(value: PerCondition, conditions: pd.Series) -> float | np.ndarray:
+    """``value`` for each row of a ``condition`` column: the number itself, or, per condition, an array aligned with
+    ``conditions`` (every condition checked by :func:`value_of`)."""
+    if not isinstance(value, Mapping):
+        return value
+    for condition in pd.unique(conditions):
+        value_of(value, condition)
+    return conditions.map(value).to_numpy(np.float64)
+
+
+def eod_rate(steps: pd.DataFrame, window: int = DEFAULTS.rate_window, *, fps: PerCondition) -> np.ndarray:
+    """Centred rolling mean of ``eod`` over ``window`` steps x ``fps`` (steps per second, each condition's as the
+    run recorded it) per agent-episode (docs/methods/analyses.md#analysis-signalling), in Hz.
 
     Only full windows count, so the first and last ``window // 2`` steps of an
     episode are NaN rather than biased by a shorter window. Row-aligned with ``steps``.
@@ -54,7 +76,7 @@ def eod_rate(steps: pd.DataFrame, window: int = DEFAULTS.rate_window, rate_hz: f
     order = steps[[*AGENT_EPISODE, "t", "eod"]].reset_index(drop=True).sort_values([*AGENT_EPISODE, "t"])
     rate = (order["eod"].astype(np.float64).groupby([order[k] for k in AGENT_EPISODE], sort=False)
             .transform(lambda s: s.rolling(window, center=True, min_periods=window).mean()))
-    return rate.sort_index().to_numpy() * rate_hz
+    return rate.sort_index().to_numpy() * values_of(fps, steps["condition"])
 
 
 def pairs(steps: pd.DataFrame, columns: Iterable[str] = ()) -> pd.DataFrame:

@@ -12,7 +12,7 @@ import numpy as np
 import pandas as pd
 from scipy import stats as sps
 
-from ._tables import AGENT_EPISODE, EPISODE, agent_sizes, nan_frame, or_nan_row, require
+from ._tables import AGENT_EPISODE, EPISODE, PerCondition, agent_sizes, nan_frame, or_nan_row, require, values_of
 from .inequality import theil_t, win_ratio
 from .selection import ols_fit
 from .stats import STAT_COLUMNS, stars
@@ -203,25 +203,26 @@ def food_time_course(steps: pd.DataFrame, every: int = 1) -> pd.DataFrame:
     return or_nan_row(out.assign(reason=""), "empty steps table")
 
 
-def reach_times(steps: pd.DataFrame, patch_xy_cm: tuple[float, float], reach_cm: float) -> pd.DataFrame:
+def reach_times(steps: pd.DataFrame, patch_xy_cm: tuple[PerCondition, PerCondition],
+                reach_cm: PerCondition) -> pd.DataFrame:
     """First step at which each agent's centre is within ``reach_cm`` of the patch centre, per agent-episode.
 
     The patch is the run's (the centre of its arena and ``arena.onepatch_radius_cm``,
     docs/model/environment.md#arenas-and-food), passed in by the caller rather
     than defaulted here, where a second copy of the arena could disagree with
-    the run. ``reached`` is False and ``t_reach`` NaN for an agent that never
-    got there.
+    the run: numbers, or each condition's as it recorded them (:data:`~efish.analysis._tables.PerCondition`).
+    ``reached`` is False and ``t_reach`` NaN for an agent that never got there.
     """
     require(steps, [*AGENT_EPISODE, "t", "x_cm", "y_cm"], "steps table")
-    d = np.hypot(steps["x_cm"].to_numpy(np.float64) - patch_xy_cm[0],
-                 steps["y_cm"].to_numpy(np.float64) - patch_xy_cm[1])
-    frame = steps[[*AGENT_EPISODE, "t"]].assign(t_in=np.where(d <= reach_cm, steps["t"], np.nan))
+    x, y, r = (values_of(v, steps["condition"]) for v in (*patch_xy_cm, reach_cm))
+    d = np.hypot(steps["x_cm"].to_numpy(np.float64) - x, steps["y_cm"].to_numpy(np.float64) - y)
+    frame = steps[[*AGENT_EPISODE, "t"]].assign(t_in=np.where(d <= r, steps["t"], np.nan))
     out = frame.groupby(AGENT_EPISODE, sort=True)["t_in"].min().rename("t_reach").reset_index()
     out["reached"] = out["t_reach"].notna()
     return out
 
 
-def reach_rates(steps: pd.DataFrame, patch_xy_cm: tuple[float, float], reach_cm: float,
+def reach_rates(steps: pd.DataFrame, patch_xy_cm: tuple[PerCondition, PerCondition], reach_cm: PerCondition,
                 agent: int | None = None) -> pd.DataFrame:
     """Fraction of episodes in which an agent reached the patch, and its median time to it, per condition and agent.
 

@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 from scipy import signal
 
-from ._tables import AGENT_EPISODE, DEFAULTS, EPISODE, RATE_HZ, nan_frame, require
+from ._tables import AGENT_EPISODE, DEFAULTS, EPISODE, PerCondition, nan_frame, require, value_of
 from .plsc_tests import plsc_collapse, shared_dimensions
 
 SUBSAMPLE_FRACTIONS = tuple(DEFAULTS.subsample_fractions)
@@ -99,12 +99,13 @@ def subsample_units(h: np.ndarray, fractions=SUBSAMPLE_FRACTIONS, draws: int = D
 
 
 def wideband_power(h: np.ndarray, window: int = DEFAULTS.spectrogram_window,
-                   overlap: int = DEFAULTS.spectrogram_overlap, fs: float = RATE_HZ) -> float:
+                   overlap: int = DEFAULTS.spectrogram_overlap, *, fs: float) -> float:
     """Mean spectrogram power over units, windows and frequencies (20-step windows, 10 overlap;
     docs/methods/analyses.md#analysis-dynamics).
 
     scipy.signal.spectrogram with its defaults otherwise (Tukey window,
-    constant detrend, power spectral density at sampling rate ``fs``); NaN when
+    constant detrend, power spectral density at sampling rate ``fs``: the steps per second the run simulated
+    ``h`` at, so the power is per Hz); NaN when
     ``h`` is degenerate or shorter than one window.
     """
     if degenerate_reason(h, min_rows=window):
@@ -115,15 +116,17 @@ def wideband_power(h: np.ndarray, window: int = DEFAULTS.spectrogram_window,
 
 def dynamics_table(hidden: pd.DataFrame, fraction: float = DEFAULTS.variance_fraction,
                    window: int = DEFAULTS.spectrogram_window, overlap: int = DEFAULTS.spectrogram_overlap,
-                   fs: float = RATE_HZ) -> pd.DataFrame:
-    """Per agent-episode of a hidden table: D_eff, PCs for ``fraction`` of the variance, wideband power, reason."""
+                   *, fps: PerCondition) -> pd.DataFrame:
+    """Per agent-episode of a hidden table: D_eff, PCs for ``fraction`` of the variance, wideband power (at its
+    condition's ``fps``), reason."""
     require(hidden, [*AGENT_EPISODE, "t"], "hidden table")
     rows = []
     for keys, sub in hidden.groupby(AGENT_EPISODE, sort=True):
         h = hidden_matrix(sub)
         rows.append({**dict(zip(AGENT_EPISODE, keys, strict=True)), "n_steps": len(h),
                      "d_eff": effective_dimensionality(h), "pcs_for_variance": pcs_for_variance(h, fraction),
-                     "wideband_power": wideband_power(h, window, overlap, fs), "reason": degenerate_reason(h)})
+                     "wideband_power": wideband_power(h, window, overlap, fs=value_of(fps, keys[0])),
+                     "reason": degenerate_reason(h)})
     return pd.DataFrame(rows, columns=[*AGENT_EPISODE, "n_steps", "d_eff", "pcs_for_variance", "wideband_power",
                                        "reason"])
 

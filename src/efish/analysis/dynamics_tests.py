@@ -18,7 +18,7 @@ import re
 import numpy as np
 import pandas as pd
 
-from ._tables import AGENT_EPISODE, EPISODE, agent_sizes, require
+from ._tables import AGENT_EPISODE, EPISODE, PerCondition, agent_sizes, require, value_of
 from .dynamics import _with_steps, degenerate_reason, units, wideband_power
 from .stats import mann_whitney, nan_stat_row, spearman, wilcoxon_paired
 
@@ -49,9 +49,10 @@ def size_tests(dims: pd.DataFrame) -> pd.DataFrame:
 
 
 def power_near_far(hidden: pd.DataFrame, steps: pd.DataFrame, near_cm: float, far_cm: float, window: int,
-                   overlap: int, fs: float) -> pd.DataFrame:
+                   overlap: int, fps: PerCondition) -> pd.DataFrame:
     """Wideband power per agent-episode over its steps with the nearest conspecific near (<= ``near_cm``) and far
-    (> ``far_cm``): one row per agent-episode and ``where``; NaN power (with a reason) when too few steps."""
+    (> ``far_cm``), at its condition's ``fps``: one row per agent-episode and ``where``; NaN power (with a reason)
+    when too few steps."""
     if far_cm < near_cm:
         raise ValueError(f"far_cm ({far_cm}) must not be below near_cm ({near_cm})")
     j, h = _with_steps(hidden, steps, ["dist_agent_cm"]), units(hidden)
@@ -59,9 +60,10 @@ def power_near_far(hidden: pd.DataFrame, steps: pd.DataFrame, near_cm: float, fa
     for keys, sub in j.groupby(AGENT_EPISODE, sort=True):
         d = sub["dist_agent_cm"].to_numpy(np.float64)
         x = sub[h].to_numpy(np.float64)  # rows in t order (_with_steps sorts)
+        fs = value_of(fps, keys[0])
         for where, keep in (("near", d <= near_cm), ("far", d > far_cm)):
             rows.append({**dict(zip(AGENT_EPISODE, keys, strict=True)), "where": where, "n_steps": int(keep.sum()),
-                         "wideband_power": wideband_power(x[keep], window, overlap, fs),
+                         "wideband_power": wideband_power(x[keep], window, overlap, fs=fs),
                          "reason": (f"only {keep.sum()} {where} steps, fewer than the {window}-step spectrogram "
                                     "window" if keep.sum() < window else degenerate_reason(x[keep], window))})
     return pd.DataFrame(rows, columns=NEAR_FAR_COLUMNS)

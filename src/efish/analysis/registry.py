@@ -2,11 +2,16 @@
 
 The workflow reads :data:`ANALYSES` to make one job per (analysis, assay of
 the scale), writing ``results/{run}/analysis/<analysis>/<assay>/<table>.parquet``;
-adding an analysis means one compute function and one entry here. Each
-compute function passes the composed config's values (``cfg.analysis``,
-``env.fps`` for ms per step and rates in Hz, the arena for the one-patch
-centre) to the pure functions of the ``efish.analysis`` modules; a statistic
-table (:attr:`Analysis.stats`) carries the columns of
+adding an analysis means one compute function and one entry here. An analysis
+reads two things only: the assay's record, its rollout tables with the
+conditions it recorded (``conditions.parquet``, read back by
+:func:`efish.config.recorded.recorded_conditions`: each condition's frame rate
+``env.fps`` for ms per step and rates in Hz, its arena for the one-patch
+centre, its roles, which condition is the control), and the analysis settings
+of the job (``cfg.analysis``, which ``efish analyze`` records beside the tables
+as ``analysis_settings.parquet``); never a config composed afresh. Each compute
+function passes their values to the pure functions of the ``efish.analysis``
+modules; a statistic table (:attr:`Analysis.stats`) carries the columns of
 :data:`efish.analysis.stats.STAT_COLUMNS`. A table whose input columns the
 rollout tables lack (a run recorded before a column existed) is one NaN row
 whose ``reason`` names them, so every declared table is always written.
@@ -17,17 +22,17 @@ whose ``reason`` names them, so every declared table is always written.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from ..config.recorded import recorded_conditions
-from ..config.schema import AssayConfig, EfishConfig
+from ..config.recorded import recorded_conditions, step_rates
+from ..config.schema import AnalysisConfig, AssayConfig, EfishConfig
 from ..io import read_parquet
-from ..layout import ROLLOUT_TABLES
+from ..layout import ANALYSIS_SETTINGS, ROLLOUT_TABLES
 from ._tables import nan_frame, or_nan_row, require
 from .behaviour import (
     bite_matrix,
@@ -61,6 +66,8 @@ from .signalling import (
 from .stats import STAT_COLUMNS, dunnett_by_measure, spearman
 
 Tables = dict[str, pd.DataFrame]
+#: Condition -> its config as the assay's run resolved it, in the assay's order (the first is the control).
+Conditions = Mapping[str, EfishConfig]
 #: Per-episode measures of :func:`efish.analysis.behaviour.episode_summary` compared between conditions.
 SUMMARY_MEASURES = ["food_total", "theil_t", "eod_probability", "mean_nn_dist_cm", "bites"]
 #: Per-agent-episode measures of :func:`efish.analysis.dynamics.dynamics_table` compared between conditions.
@@ -69,23 +76,37 @@ DYNAMICS_MEASURES = ["d_eff", "pcs_for_variance", "wideband_power"]
 
 @dataclass(frozen=True)
 class Analysis:
-    """One analysis: its compute function, the rollout tables it reads, its assays (docs/methods/assays.md) and output
+    """One analysis: its compute function (of the rollout tables, the job's analysis settings and the recorded
+    conditions), the rollout tables it reads (always ``conditions``), its assays (docs/methods/assays.md) and output
     tables."""
 
     name: str
-    compute: Callable[[Tables, EfishConfig], Tables]
+    compute: Callable[[Tables, AnalysisConfig, Conditions], Tables]
     reads: tuple[str, ...]
     assays: tuple[str, ...]
     outputs: tuple[str, ...]
     stats: tuple[str, ...] = ()  # outputs that are statistic tables (STAT_COLUMNS)
 
+    def __post_init__(self):
+        if "conditions" not in self.reads:  # what the run simulated is read from its record, nowhere else
+            raise ValueError(f"analysis {self.name!r} must read 'conditions' (the assay's recorded conditions): "
+                             f"it reads {list(self.reads)}")
+        if ANALYSIS_SETTINGS in self.outputs:
+            raise ValueError(f"analysis {self.name!r}: {ANALYSIS_SETTINGS!r} is the job's settings table, no output")
+
+    @property
+    def written(self) -> tuple[str, ...]:
+        """Every table its job writes: the :attr:`outputs`, then the analysis settings it ran with
+        (:data:`~efish.layout.ANALYSIS_SETTINGS`)."""
+        return (*self.outputs, ANALYSIS_SETTINGS)
+
 
 # ------------------------------------------------------------------ helpers
-def control_condition(conditions: Iterable, cfg: EfishConfig):
-    """The condition others are compared with: the assay's first listed condition if present, else the first present."""
-    present = sorted(c for c in set(conditions) if isinstance(c, str))
-    first = next(iter(cfg.assay.conditions), None)
-    return first if first in present or not present else present[0]
+def control_condition(present: Iterable, conditions: Conditions):
+    """The condition others are compared with: the first of the assay's recorded conditions (in its order) that is
+    ``present`` in a table; the first recorded when none is."""
+    present = set(present)
+    return next((c for c in conditions if c in present), next(iter(conditions), None))
 
 
 def _lacking(table: pd.DataFrame, columns: Iterable[str], outputs: Iterable[str], stats: Iterable[str] = ()) -> Tables:
@@ -97,36 +118,36 @@ def _lacking(table: pd.DataFrame, columns: Iterable[str], outputs: Iterable[str]
     return {name: row.reindex(columns=STAT_COLUMNS) if name in stats else row for name in outputs}
 
 
-def _homer(cfg: EfishConfig) -> int | None:
-    """The homing agent (the one that is not the target) of a two-agent homing config; None otherwise."""
-    if cfg.env.task != "homing" or cfg.env.n_agents != 2:
+def _homer(cfg: EfishConfig | None) -> int | None:
+    """The homing agent (the one that is not the target) of a two-agent homing condition; None otherwise."""
+    if cfg is None or cfg.env.task != "homing" or cfg.env.n_agents != 2:
         return None
     return 1 - cfg.env.homing_target
 
 
 # ------------------------------------------------------------- signalling
-def _idi_samples(ids: pd.DataFrame, conditions: Iterable, cfg: EfishConfig) -> dict[tuple, np.ndarray | str]:
+def _idi_samples(ids: pd.DataFrame, present: Iterable, a: AnalysisConfig) -> dict[tuple, np.ndarray | str]:
     """IDIs per (source, condition): the agents' in whole steps, the real fish's in ms, or why there are none."""
-    samples = {("agents", c): ids.loc[ids["condition"] == c, "idi_steps"].to_numpy() for c in sorted(conditions)}
-    real = load_real_idis(cfg.analysis.real_fish_idis)
+    samples = {("agents", c): ids.loc[ids["condition"] == c, "idi_steps"].to_numpy() for c in sorted(present)}
+    real = load_real_idis(a.real_fish_idis)
     samples["real_fish", np.nan] = real["reason"].iloc[0] or real["idi_ms"].to_numpy()
     return samples
 
 
-def _idi_tables(ids: pd.DataFrame, conditions: Iterable, cfg: EfishConfig) -> Tables:
+def _idi_tables(ids: pd.DataFrame, present: Iterable, a: AnalysisConfig, fps: Mapping[str, float]) -> Tables:
     """IDI histograms and power-law fits per source and condition (Fig 3C,D; supplement).
 
     The agents' IDIs are whole steps and are fitted as a discrete power law from
-    ``analysis.xmin_ms`` rounded up to steps (as the authors fit them); the real
-    fish's are fitted continuously in ms. ``xmin`` is in ms in both rows.
+    ``analysis.xmin_ms`` rounded up to steps of their condition (1000 / its
+    recorded ``fps`` ms; as the authors fit them); the real fish's are fitted
+    continuously in ms. ``xmin`` is in ms in both rows.
     """
-    a, hist, fits = cfg.analysis, [], []
-    step_ms = 1000.0 / cfg.env.fps
-    for (source, cond), x in _idi_samples(ids, conditions, cfg).items():
+    hist, fits = [], []
+    for (source, cond), x in _idi_samples(ids, present, a).items():
         keys = {"source": source, "condition": cond}
         discrete = source == "agents"
-        xmin = xmin_in_steps(a.xmin_ms, step_ms) if discrete else a.xmin_ms
-        scale = step_ms if discrete else 1.0
+        scale = 1000.0 / fps[cond] if discrete else 1.0  # ms of one unit of x: a step of the condition, or 1 ms
+        xmin = xmin_in_steps(a.xmin_ms, scale) if discrete else a.xmin_ms
         extra = {"discrete": discrete, "xmin_steps": float(xmin) if discrete else np.nan}
         if isinstance(x, str):  # no sample: say why
             hist.append(nan_frame(x, **keys))
@@ -138,17 +159,19 @@ def _idi_tables(ids: pd.DataFrame, conditions: Iterable, cfg: EfishConfig) -> Ta
     return {"idi_histogram": pd.concat(hist, ignore_index=True), "power_law": pd.DataFrame(fits)}
 
 
-def _signalling(t: Tables, cfg: EfishConfig) -> Tables:
-    """IDIs, their histograms and power laws, EOD rate vs distance and around events, rate vs size (Fig 3C-J,P)."""
-    a, steps, fps = cfg.analysis, t["steps"], cfg.env.fps
+def _signalling(t: Tables, a: AnalysisConfig, conditions: Conditions) -> Tables:
+    """IDIs, their histograms and power laws, EOD rate vs distance and around events, rate vs size (Fig 3C-J,P),
+    each condition in its recorded steps per second."""
+    steps, fps = t["steps"], step_rates(conditions)
     ranges = {"agent": a.agent_range_cm, "food": a.food_range_cm, "wall": a.wall_range_cm}
-    ids, advantage = idis(steps, 1000.0 / fps), rate_advantage_vs_size(steps, a.bout_cm, a.rate_window, fps)
+    ids, advantage = idis(steps, fps=fps), rate_advantage_vs_size(steps, a.bout_cm, a.rate_window, fps=fps)
     return {
-        "idis": or_nan_row(ids, "no agent discharged twice"), **_idi_tables(ids, steps["condition"].unique(), cfg),
+        "idis": or_nan_row(ids, "no agent discharged twice"),
+        **_idi_tables(ids, steps["condition"].unique(), a, fps),
         "rate_by_distance": pd.concat([eod_rate_by_distance(steps, to, a.rate_bins, (0.0, hi), a.min_samples,
-                                                            a.rate_window, fps) for to, hi in ranges.items()],
+                                                            a.rate_window, fps=fps) for to, hi in ranges.items()],
                                       ignore_index=True),
-        "peri_event": pd.concat([peri_event_rate(steps, e, a.peri_window, a.min_events, a.rate_window, fps)
+        "peri_event": pd.concat([peri_event_rate(steps, e, a.peri_window, a.min_events, a.rate_window, fps=fps)
                                  for e in EVENTS], ignore_index=True),
         "rate_advantage": advantage,
         "rate_tests": spearman(advantage, "size_advantage", "rate_advantage_hz", by="condition"),
@@ -156,11 +179,11 @@ def _signalling(t: Tables, cfg: EfishConfig) -> Tables:
 
 
 # -------------------------------------------------------------- behaviour
-def _behaviour(t: Tables, cfg: EfishConfig) -> Tables:
+def _behaviour(t: Tables, a: AnalysisConfig, conditions: Conditions) -> Tables:
     """Food, food vs size, Theil T, win ratios, bites by size, spacing, EOD probability, condition tests (Figs 3-4)."""
     episodes, steps = t["episodes"], t["steps"]
     wins, eod, summary = win_ratios(episodes), eod_probability(steps), episode_summary(episodes)
-    control = control_condition(summary["condition"], cfg)
+    control = control_condition(summary["condition"], conditions)
     bites = _lacking(steps, ["bite_target"], ["bite_matrix"]) or {"bite_matrix": bite_matrix(steps)}
     theil = theil_per_episode(episodes)
     return {
@@ -172,7 +195,7 @@ def _behaviour(t: Tables, cfg: EfishConfig) -> Tables:
                                  .assign(measure="eod_probability"),
                                  spearman(theil, "size_theil_t", "theil_t", by="condition")  # Fig 3N
                                  .assign(measure="theil_t")], ignore_index=True),
-        "condition_tests": dunnett_by_measure(summary, SUMMARY_MEASURES, "condition", control, cfg.analysis.seed),
+        "condition_tests": dunnett_by_measure(summary, SUMMARY_MEASURES, "condition", control, a.seed),
     }
 
 
@@ -180,9 +203,9 @@ def _behaviour(t: Tables, cfg: EfishConfig) -> Tables:
 BITE_OUTPUTS = ("bouts", "chase_sizes", "bite_sizes", "bite_timing", "bite_rate_by_class", "size_tests")
 
 
-def _interactions(t: Tables, cfg: EfishConfig) -> Tables:
+def _interactions(t: Tables, a: AnalysisConfig, conditions: Conditions) -> Tables:
     """Ethogram of pair labels, bouts, chaser and biter sizes, bite timing and rate by class (Figs 3A, 5K-P)."""
-    a, steps = cfg.analysis, t["steps"]
+    steps = t["steps"]
     labels = {"labels": label_counts(steps, a.facing_rad, a.away_rad)}
     if lacking := _lacking(steps, ["bite_target"], BITE_OUTPUTS, ["size_tests"]):
         return {**labels, **lacking}
@@ -196,39 +219,42 @@ def _interactions(t: Tables, cfg: EfishConfig) -> Tables:
 
 
 # ----------------------------------------------------------------- homing
-def _homing(t: Tables, cfg: EfishConfig) -> Tables:
-    """Error-angle histograms and time courses, trajectory shape, electric vs ray casting (Fig 2B-D)."""
+def _homing(t: Tables, a: AnalysisConfig, conditions: Conditions) -> Tables:
+    """Error-angle histograms and time courses, trajectory shape, electric vs ray casting (Fig 2B-D); the homer is
+    the control condition's, as the run recorded it."""
     steps = t["steps"]
     needs_one = [] if set(ERROR_COLUMNS.values()) & set(steps.columns) else ERROR_COLUMNS.values()
     errors = _lacking(steps, needs_one, ["error_histogram", "error_vs_time"]) or {
         "error_histogram": error_histogram(steps), "error_vs_time": error_vs_time(steps)}
-    control = control_condition(steps["condition"], cfg)
+    control = control_condition(steps["condition"], conditions)
     return {**errors, "trajectory_shape": trajectory_shape(steps),
-            "perception": compare_perception(steps, control, None, _homer(cfg))}
+            "perception": compare_perception(steps, control, None, _homer(conditions.get(control)))}
 
 
 # --------------------------------------------------------------- onepatch
-def _onepatch(t: Tables, cfg: EfishConfig) -> Tables:
+def _onepatch(t: Tables, a: AnalysisConfig, conditions: Conditions) -> Tables:
     """Cumulative food over time, reach rates of the arena's central patch, and the tests by role (Fig 5E-J); who
-    is A, B, the bot or alone comes from the conditions the run recorded."""
-    steps, arena = t["steps"], cfg.arena
-    centre = (arena.width_cm / 2, arena.height_cm / 2)
-    reach = reach_rates(steps, centre, arena.onepatch_radius_cm)
-    configs = recorded_conditions(t["conditions"], "the assay's conditions table")
+    is A, B, the bot or alone, and each condition's arena, come from the conditions the run recorded."""
+    steps, arenas = t["steps"], {c: cfg.arena for c, cfg in conditions.items()}
+    centre = ({c: arena.width_cm / 2 for c, arena in arenas.items()},
+              {c: arena.height_cm / 2 for c, arena in arenas.items()})
+    reach = reach_rates(steps, centre, {c: arena.onepatch_radius_cm for c, arena in arenas.items()})
     return {"food_time_course": food_time_course(steps), "reach_rates": reach,
-            "role_tests": role_tests(food_from_steps(steps), configs), "reach_tests": reach_tests(reach, configs)}
+            "role_tests": role_tests(food_from_steps(steps), conditions),
+            "reach_tests": reach_tests(reach, conditions)}
 
 
 # --------------------------------------------------------------- dynamics
-def _dynamics(t: Tables, cfg: EfishConfig) -> Tables:
+def _dynamics(t: Tables, a: AnalysisConfig, conditions: Conditions) -> Tables:
     """Hidden-state dimensionality, power, unit subsampling, decoding per episode and its mean over episodes (also of
     food near and far; homing: the homer's states), PLSC of agents 0 and 1 with the test of fewer shared dimensions
-    far than near, and the tests of D_eff against group size and of wideband power by context (Fig 6)."""
-    a, hidden, steps = cfg.analysis, t["hidden"], t["steps"]
+    far than near, and the tests of D_eff against group size and of wideband power by context (Fig 6), each
+    condition's power per Hz of its recorded steps per second."""
+    hidden, steps, fps = t["hidden"], t["steps"], step_rates(conditions)
     rng = np.random.default_rng(a.seed)
-    dims = dynamics_table(hidden, a.variance_fraction, a.spectrogram_window, a.spectrogram_overlap, cfg.env.fps)
-    control = control_condition(dims["condition"], cfg)
-    homer = _homer(cfg)
+    dims = dynamics_table(hidden, a.variance_fraction, a.spectrogram_window, a.spectrogram_overlap, fps=fps)
+    control = control_condition(dims["condition"], conditions)
+    homer = _homer(conditions.get(control))
     decoded = decode_episodes(hidden, steps, folds=a.decode_folds, agent=homer)
     food = food_decode_episodes(hidden, steps, a.claims_food_near_cm, a.decode_folds, homer)
     return {"dimensionality": dims,
@@ -240,17 +266,17 @@ def _dynamics(t: Tables, cfg: EfishConfig) -> Tables:
             "plsc_collapse": plsc_collapse_table(hidden, steps, (0, 1), a.plsc_edges_cm, a.plsc_null_draws,
                                                  a.claims_alpha, swaps=a.plsc_label_swaps, rng=rng),
             "condition_tests": dunnett_by_measure(dims, DYNAMICS_MEASURES, "condition", control, a.seed),
-            "size_tests": size_tests(dims), **_power(hidden, steps, dims, cfg)}
+            "size_tests": size_tests(dims), **_power(hidden, steps, dims, a, fps)}
 
 
-def _power(hidden: pd.DataFrame, steps: pd.DataFrame, dims: pd.DataFrame, cfg: EfishConfig) -> Tables:
+def _power(hidden: pd.DataFrame, steps: pd.DataFrame, dims: pd.DataFrame, a: AnalysisConfig,
+           fps: Mapping[str, float]) -> Tables:
     """Wideband power near vs far from the nearest conspecific, and its tests (Fig 6I,J); NaN rows without the
     steps columns it needs."""
-    a = cfg.analysis
     if lacking := _lacking(steps, ["dist_agent_cm", "size"], ["power_near_far", "power_tests"], ["power_tests"]):
         return lacking
     near_far = power_near_far(hidden, steps, a.claims_near_cm, a.claims_far_cm, a.spectrogram_window,
-                              a.spectrogram_overlap, cfg.env.fps)
+                              a.spectrogram_overlap, fps)
     return {"power_near_far": or_nan_row(near_far, "no agent-episode with a hidden state"),
             "power_tests": power_tests(near_far, dims, steps)}
 
@@ -259,20 +285,21 @@ def _power(hidden: pd.DataFrame, steps: pd.DataFrame, dims: pd.DataFrame, cfg: E
 FORAGING = ("patchy4", "uniform4", "ablation4", "ablation1", "collective", "mute", "npatch", "food_scarcity",
             "groupsize", "onepatch")
 ANALYSES: dict[str, Analysis] = {a.name: a for a in [
-    Analysis("signalling", _signalling, ("steps",), ("patchy4", "wide2"),
+    Analysis("signalling", _signalling, ("steps", "conditions"), ("patchy4", "wide2"),
              ("idis", "idi_histogram", "power_law", "rate_by_distance", "peri_event", "rate_advantage",
               "rate_tests"), ("rate_tests",)),
-    Analysis("behaviour", _behaviour, ("steps", "episodes"), FORAGING,
+    Analysis("behaviour", _behaviour, ("steps", "episodes", "conditions"), FORAGING,
              ("food_per_agent", "food_vs_size", "theil", "win_ratio", "bite_matrix", "nearest_neighbour",
               "eod_probability", "episode_summary", "size_tests", "condition_tests"),
              ("food_vs_size", "size_tests", "condition_tests")),
-    Analysis("interactions", _interactions, ("steps",), ("patchy4", "square2"), ("labels", *BITE_OUTPUTS),
-             ("size_tests",)),
-    Analysis("homing", _homing, ("steps",), ("homing",),
+    Analysis("interactions", _interactions, ("steps", "conditions"), ("patchy4", "square2"),
+             ("labels", *BITE_OUTPUTS), ("size_tests",)),
+    Analysis("homing", _homing, ("steps", "conditions"), ("homing",),
              ("error_histogram", "error_vs_time", "trajectory_shape", "perception"), ("perception",)),
     Analysis("onepatch", _onepatch, ("steps", "conditions"), ("onepatch", "bot"),
              ("food_time_course", "reach_rates", "role_tests", "reach_tests"), ("role_tests", "reach_tests")),
-    Analysis("dynamics", _dynamics, ("hidden", "steps"), ("patchy4", "wide2", "homing", "groupsize", "square2"),
+    Analysis("dynamics", _dynamics, ("hidden", "steps", "conditions"),
+             ("patchy4", "wide2", "homing", "groupsize", "square2"),
              ("dimensionality", "subsampling", "decoding", "decoding_episodes", "food_decoding",
               "food_decoding_episodes", "plsc", "plsc_collapse", "condition_tests", "size_tests", "power_near_far",
               "power_tests"), ("condition_tests", "size_tests", "power_tests")),
@@ -307,12 +334,25 @@ def read_tables(name: str, folder: str | Path) -> Tables:
     return {t: read_parquet(p, f"the {t} table") for t, p in paths.items()}
 
 
-def run(name: str, tables: Tables, cfg: EfishConfig) -> Tables:
-    """The output tables of analysis ``name`` (:attr:`Analysis.outputs`, in order) from its input ``tables``."""
+def recorded(tables: Tables) -> Conditions:
+    """The conditions an assay's ``conditions`` table records, checked to name every condition of its other
+    ``tables``: a row of a condition the run did not record has no frame rate or arena to be read in."""
+    conditions = recorded_conditions(tables["conditions"], "the assay's conditions table")
+    for name, table in tables.items():
+        if name != "conditions" and "condition" in table.columns:
+            if unknown := sorted(set(table["condition"].dropna()) - set(conditions), key=str):
+                raise ValueError(f"the {name} table holds conditions {unknown} that the assay's conditions table "
+                                 f"does not record ({', '.join(conditions)}): the tables are of different runs")
+    return conditions
+
+
+def run(name: str, tables: Tables, settings: AnalysisConfig) -> Tables:
+    """The output tables of analysis ``name`` (:attr:`Analysis.outputs`, in order) from its input ``tables`` (the
+    assay's rollout tables with its recorded ``conditions``) under the analysis ``settings`` (``cfg.analysis``)."""
     analysis = get(name)
     if missing := [t for t in analysis.reads if t not in tables]:
         raise ValueError(f"analysis {name!r} needs the tables {missing}")
-    out = analysis.compute(tables, cfg)
+    out = analysis.compute(tables, settings, recorded({t: tables[t] for t in analysis.reads}))
     if set(out) != set(analysis.outputs):
         raise RuntimeError(f"analysis {name!r} returned {sorted(out)}, declared {sorted(analysis.outputs)}")
     for table in analysis.stats:

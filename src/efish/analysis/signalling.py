@@ -2,8 +2,10 @@
 context.
 
 The EOD rate of a step is the 20-step centred rolling mean of ``eod`` times
-83 Hz, computed per agent-episode. Rates are binned against distances,
-aligned on events, or compared between agents close to each other.
+the steps per second its condition was simulated at (``env.fps`` as the run
+recorded it, 83 Hz by default), computed per agent-episode; ms per step are
+1000 / that. Rates are binned against distances, aligned on events, or
+compared between agents close to each other.
 """
 
 from __future__ import annotations
@@ -20,13 +22,13 @@ from ._tables import (
     AGENT_EPISODE,
     DEFAULTS,
     EPISODE,
-    RATE_HZ,
-    STEP_MS,
+    PerCondition,
     agent_sizes,
     eod_rate,
     nan_frame,
     pairs,
     require,
+    values_of,
 )
 from .stats import cluster_sum_t_test
 
@@ -37,18 +39,18 @@ DISTANCE_RANGES_CM = {to: (0.0, getattr(DEFAULTS, f"{to}_range_cm")) for to in (
 EVENTS = ("ate", "bit", "was_bitten")
 
 
-def idis(steps: pd.DataFrame, step_ms: float = STEP_MS) -> pd.DataFrame:
+def idis(steps: pd.DataFrame, *, fps: PerCondition) -> pd.DataFrame:
     """One row per inter-discharge interval: the step difference of consecutive EODs of an agent-episode.
 
     Columns: condition, episode, agent, t (step of the later discharge),
-    ``idi_steps`` and ``idi_ms`` = ``idi_steps`` x ``step_ms`` (12.048 ms,
-    docs/methods/analyses.md#analysis-signalling).
+    ``idi_steps`` and ``idi_ms`` = ``idi_steps`` x 1000 / ``fps`` (the condition's steps per second; 12.048 ms
+    a step at 83, docs/methods/analyses.md#analysis-signalling).
     """
     require(steps, [*AGENT_EPISODE, "t", "eod"], "steps table")
     fired = steps.loc[steps["eod"].astype(bool), [*AGENT_EPISODE, "t"]].sort_values([*AGENT_EPISODE, "t"])
     fired["idi_steps"] = fired.groupby(AGENT_EPISODE, sort=False)["t"].diff()
     out = fired.dropna(subset=["idi_steps"]).astype({"idi_steps": np.int64})
-    out["idi_ms"] = out["idi_steps"] * step_ms
+    out["idi_ms"] = out["idi_steps"] * (1000.0 / values_of(fps, out["condition"]))
     return out.reset_index(drop=True)
 
 
@@ -209,7 +211,7 @@ def power_law_vs_exponential_clustered(idis: pd.DataFrame, xmin: float, value: s
             "reason": notes}
 
 
-def xmin_in_steps(xmin_ms: float, step_ms: float = STEP_MS) -> int:
+def xmin_in_steps(xmin_ms: float, step_ms: float) -> int:
     """The smallest whole step count at or above ``xmin_ms`` (12 ms -> 1 step of 12.048 ms), at least 1."""
     return max(1, int(np.ceil(xmin_ms / step_ms - 1e-9)))
 
@@ -250,8 +252,9 @@ def _binned_mean_sem(values: np.ndarray, x: np.ndarray, edges: np.ndarray, min_s
 
 def eod_rate_by_distance(steps: pd.DataFrame, to: str, bins: int = DEFAULTS.rate_bins,
                          range_cm: tuple[float, float] | None = None, min_samples: int = DEFAULTS.min_samples,
-                         window: int = DEFAULTS.rate_window, rate_hz: float = RATE_HZ) -> pd.DataFrame:
-    """Mean +- SEM EOD rate (Hz) in ``bins`` equal distance bins to the nearest ``to`` (agent, food or wall).
+                         window: int = DEFAULTS.rate_window, *, fps: PerCondition) -> pd.DataFrame:
+    """Mean +- SEM EOD rate (Hz, at each condition's ``fps``) in ``bins`` equal distance bins to the nearest ``to``
+    (agent, food or wall).
 
     Ranges default to docs/methods/analyses.md#analysis-signalling: 0-150 cm for agents, 0-10 cm for food and wall.
     Samples are steps (every agent-step with a full rate window), per condition;
@@ -263,7 +266,7 @@ def eod_rate_by_distance(steps: pd.DataFrame, to: str, bins: int = DEFAULTS.rate
     column = f"dist_{to}_cm"
     require(steps, ["condition", column], "steps table")
     edges = np.linspace(*(range_cm or DISTANCE_RANGES_CM[to]), bins + 1)
-    rate, dist = eod_rate(steps, window, rate_hz), steps[column].to_numpy(np.float64)
+    rate, dist = eod_rate(steps, window, fps=fps), steps[column].to_numpy(np.float64)
     parts = []
     for cond, idx in steps.groupby("condition", sort=True).indices.items():
         table = _binned_mean_sem(rate[idx], dist[idx], edges, min_samples)
@@ -285,9 +288,9 @@ def _event_triggered(rate: np.ndarray, events: np.ndarray, lags: np.ndarray) -> 
 
 def peri_event_rate(steps: pd.DataFrame, event: str, window: int = DEFAULTS.peri_window,
                     min_events: int = DEFAULTS.min_events, rate_window: int = DEFAULTS.rate_window,
-                    rate_hz: float = RATE_HZ) -> pd.DataFrame:
-    """Mean +- SEM EOD rate (Hz) from ``window`` steps before to ``window`` after an ``event``
-    (docs/methods/analyses.md#analysis-signalling).
+                    *, fps: PerCondition) -> pd.DataFrame:
+    """Mean +- SEM EOD rate (Hz, at each condition's ``fps``) from ``window`` steps before to ``window`` after an
+    ``event`` (docs/methods/analyses.md#analysis-signalling); ``lag_ms`` is the lag in the condition's ms.
 
     ``event`` is a boolean steps column: ``ate``, ``bit`` or ``was_bitten``.
     Each agent-episode with at least ``min_events`` events contributes its mean
@@ -299,7 +302,7 @@ def peri_event_rate(steps: pd.DataFrame, event: str, window: int = DEFAULTS.peri
         raise ValueError(f"event must be one of {list(EVENTS)}, got {event!r}")
     require(steps, [*AGENT_EPISODE, "t", event], "steps table")
     lags = np.arange(-window, window + 1)
-    rate = eod_rate(steps, rate_window, rate_hz)
+    rate = eod_rate(steps, rate_window, fps=fps)
     frame = steps[[*AGENT_EPISODE, "t", event]].assign(rate=rate).sort_values([*AGENT_EPISODE, "t"])
     parts = []
     for cond, sub in frame.groupby("condition", sort=True):
@@ -316,12 +319,12 @@ def peri_event_rate(steps: pd.DataFrame, event: str, window: int = DEFAULTS.peri
         return nan_frame("empty steps table", condition=np.nan, lag=np.nan, n_agents=0, mean_hz=np.nan,
                          sem_hz=np.nan)
     out = pd.concat(parts, ignore_index=True).assign(event=event)
-    out["lag_ms"] = out["lag"] * 1000.0 / rate_hz  # rate_hz is the step rate (env.fps)
+    out["lag_ms"] = out["lag"] * 1000.0 / values_of(fps, out["condition"])
     return out
 
 
 def rate_advantage_vs_size(steps: pd.DataFrame, within_cm: float = DEFAULTS.bout_cm,
-                           window: int = DEFAULTS.rate_window, rate_hz: float = RATE_HZ) -> pd.DataFrame:
+                           window: int = DEFAULTS.rate_window, *, fps: PerCondition) -> pd.DataFrame:
     """Per pair of agents and episode: EOD-rate advantage vs size advantage while within ``within_cm`` (Fig 3P).
 
     One row per unordered pair (``agent`` < ``partner``): ``size_advantage`` =
@@ -331,7 +334,7 @@ def rate_advantage_vs_size(steps: pd.DataFrame, within_cm: float = DEFAULTS.bout
     :func:`efish.analysis.stats.spearman`.
     """
     require(steps, [*AGENT_EPISODE, "t", "eod", "size", "x_cm", "y_cm"], "steps table")
-    frame = steps.assign(rate=eod_rate(steps, window, rate_hz))
+    frame = steps.assign(rate=eod_rate(steps, window, fps=fps))
     p = pairs(frame, ["rate"])
     p = p[(p["agent"] < p["partner"]) & (p["dist_cm"] <= within_cm)]
     p = p.assign(diff=p["rate"] - p["rate_p"]).dropna(subset=["diff"])

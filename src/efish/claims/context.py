@@ -20,8 +20,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from ..config.recorded import recorded_conditions
 from ..config.schema import EfishConfig
-from ..layout import parse_table
+from ..layout import assay_table, parse_table
 from .statistics import bootstrap_ci
 from .verdicts import MIN_UNITS, Outcome, Part, combine, judge
 
@@ -79,7 +80,9 @@ def evaluate(label: str, statistic: str, compute: Callable[[], Outcome], alpha: 
 
 @dataclass
 class Context:
-    """What a claim's parts share: its tables, the config, the claim's own seeded generator."""
+    """What a claim's parts share: its tables, the config (the claims' own settings, ``cfg.analysis``), the claim's
+    own seeded generator. What the run simulated (a condition's frame rate, sizes, roles) is read from the record
+    of the assay (:meth:`recorded`), never from ``cfg``."""
 
     claim: str
     tables: Tables
@@ -95,6 +98,12 @@ class Context:
         if path not in self.tables:
             raise MissingTable(path)
         return self.tables[path]
+
+    def recorded(self, assay: str) -> Mapping[str, EfishConfig]:
+        """The conditions ``assay`` recorded, in its order (``assays/<assay>/conditions.parquet``, which the claim
+        names among its tables; :func:`efish.config.recorded.recorded_conditions`)."""
+        path = assay_table(assay, "conditions")
+        return recorded_conditions(self.table(path), path)
 
     def ci(self, data: pd.DataFrame, stat: Callable[[pd.DataFrame], float], units_: Iterable[str] = ("episode",),
            strata: str | None = "condition", resamples: int | None = None) -> tuple[float, float]:

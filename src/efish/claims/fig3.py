@@ -11,8 +11,9 @@ import numpy as np
 import pandas as pd
 from scipy import stats as sps
 
-from ..analysis._tables import AGENT_EPISODE, eod_rate
+from ..analysis._tables import AGENT_EPISODE, eod_rate, value_of
 from ..analysis.signalling import EVENTS, peri_event_rate, power_law_vs_exponential_clustered
+from ..config.recorded import step_rates
 from ..layout import analysis_table, assay_table
 from .context import Context, claim
 from .parts import one_sample_part, per_episode, slope_of, spearman_part, stat_row
@@ -47,7 +48,7 @@ def c4(ctx: Context) -> list[Part]:
                      "across episodes", compute)]
 
 
-WIDE2_STEPS = assay_table("wide2", "steps")
+WIDE2_STEPS, WIDE2_CONDITIONS = assay_table("wide2", "steps"), assay_table("wide2", "conditions")
 
 
 def _friedman_w(per: pd.DataFrame) -> tuple[float, float, int, int]:
@@ -67,15 +68,15 @@ def _friedman_w(per: pd.DataFrame) -> tuple[float, float, int, int]:
     return float(chi2 / (n * (k - 1))), float(p), n, k
 
 
-@claim("C5", "3E-G", "the EOD rate varies with distance to agent, food and wall", [WIDE2_STEPS])
+@claim("C5", "3E-G", "the EOD rate varies with distance to agent, food and wall", [WIDE2_STEPS, WIDE2_CONDITIONS])
 def c5(ctx: Context) -> list[Part]:
     a = ctx.cfg.analysis
 
     def compute(to: str) -> Outcome:
-        steps = ctx.table(WIDE2_STEPS)
+        steps, fps = ctx.table(WIDE2_STEPS), step_rates(ctx.recorded("wide2"))  # Hz at each condition's rate
         dist = steps[f"dist_{to}_cm"].to_numpy(np.float64)
         edges = np.linspace(0.0, getattr(a, f"{to}_range_cm"), a.rate_bins + 1)
-        frame = steps[AGENT_EPISODE].assign(rate=eod_rate(steps, a.rate_window, ctx.cfg.env.fps),
+        frame = steps[AGENT_EPISODE].assign(rate=eod_rate(steps, a.rate_window, fps=fps),
                                             bin=np.clip(np.searchsorted(edges, dist, side="right") - 1, 0,
                                                         a.rate_bins - 1))
         frame = frame[np.isfinite(frame["rate"]) & (dist >= edges[0]) & (dist <= edges[-1])]
@@ -97,7 +98,7 @@ def c5(ctx: Context) -> list[Part]:
 
 
 @claim("C6", "3H-J", "the EOD rate rises around eating, builds before biting, rises around being bitten",
-       [WIDE2_STEPS])
+       [WIDE2_STEPS, WIDE2_CONDITIONS])
 def c6(ctx: Context) -> list[Part]:
     a = ctx.cfg.analysis
     (e0, e1), (b0, b1) = a.claims_event_window, a.claims_baseline_window
@@ -105,12 +106,15 @@ def c6(ctx: Context) -> list[Part]:
     def compute(event: str) -> Outcome:
         if max(abs(e0), abs(e1), abs(b0), abs(b1)) > a.peri_window:
             raise ValueError(f"the windows reach beyond analysis.peri_window = {a.peri_window} steps")
-        steps = ctx.table(WIDE2_STEPS)
+        steps, fps = ctx.table(WIDE2_STEPS), step_rates(ctx.recorded("wide2"))
+        if steps.empty:
+            raise ValueError("the wide2 steps table is empty")
         # one peri-event curve per agent-episode: peri_event_rate averages within a condition, so each
-        # agent-episode becomes its own condition here
+        # agent-episode becomes its own condition here, in Hz at its real condition's recorded rate
         unit = steps["condition"].astype(str) + "|" + steps["episode"].astype(str) + "|" + steps["agent"].astype(str)
-        curves = peri_event_rate(steps.assign(condition=unit), event, a.peri_window, a.min_events, a.rate_window,
-                                 ctx.cfg.env.fps)
+        curves = pd.concat([peri_event_rate(sub.assign(condition=unit[sub.index]), event, a.peri_window, a.min_events,
+                                            a.rate_window, fps=value_of(fps, cond))
+                            for cond, sub in steps.groupby("condition", sort=True)], ignore_index=True)
         curves = curves[curves["n_agents"] > 0]
         if curves.empty:
             raise ValueError(f"no agent-episode has {a.min_events} or more '{event}' events")

@@ -13,8 +13,7 @@ import numpy as np
 import pandas as pd
 
 from ..analysis.interactions import bite_rate_by_class
-from ..analysis.onepatch import REACH_CONTRASTS, Configs, bot_reach_counts, matched_alone, roles, social_conditions
-from ..config.recorded import recorded_conditions
+from ..analysis.onepatch import REACH_CONTRASTS, bot_reach_counts, matched_alone, roles, social_conditions
 from ..layout import analysis_table, assay_table
 from .context import Context, claim
 from .fig3 import size_roles
@@ -35,15 +34,10 @@ ONEPATCH_FOOD = analysis_table("behaviour", "onepatch", "food_per_agent")
 ONEPATCH_CONDITIONS = assay_table("onepatch", "conditions")
 
 
-def _recorded(ctx: Context, conditions: str) -> Configs:
-    """The conditions the assay recorded (who is A, B, the bot or alone, and their sizes)."""
-    return recorded_conditions(ctx.table(conditions), conditions)
-
-
 @claim("C14", "5E-H", "intruder B eats more with A present than alone; A is unaffected; B does better when larger",
        [ONEPATCH_FOOD, ONEPATCH_CONDITIONS])
 def c14(ctx: Context) -> list[Part]:
-    configs = _recorded(ctx, ONEPATCH_CONDITIONS)
+    configs = ctx.recorded("onepatch")  # who is A, B or alone, and their sizes
     matched = matched_alone(configs)
 
     def people() -> pd.DataFrame:
@@ -92,7 +86,7 @@ def _reach(ctx: Context, contrast: str) -> Outcome:
     """The onepatch analysis's Fisher row of B's reach rate (pooled episodes); interval over episodes."""
     row = stat_row(ctx.table(BOT_REACH_TESTS), contrast=contrast)
     a, b = REACH_CONTRASTS[contrast]
-    counts = bot_reach_counts(ctx.table(BOT_REACH), _recorded(ctx, BOT_CONDITIONS), contrast)
+    counts = bot_reach_counts(ctx.table(BOT_REACH), ctx.recorded("bot"), contrast)
     present(counts.reset_index(), "group", [a, b], "bot episodes")
     # one row per episode (reached or not): the reach table's counts, resampled as episodes
     per = pd.DataFrame([{"condition": g, "episode": i, "reached": i < k}

@@ -40,5 +40,5 @@ def produced_tables(assays: Mapping[str, AssayConfig]) -> set[str]:
         written = tables_written(assay)
         out |= {assay_table(name, t) for t in written}
         out |= {analysis_table(a.name, name, t) for a in ANALYSES.values()
-                if name in a.assays and set(a.reads) <= set(written) for t in a.outputs}
+                if name in a.assays and set(a.reads) <= set(written) for t in a.written}
     return out

@@ -27,8 +27,8 @@ from .style import (
     FOOD_RANGE_COLOURS,
     NEUTRAL_COLOUR,
     RECEPTOR_COLOURS,
+    analysis_settings,
     annotate_stars,
-    assay_conditions,
     box_strip,
     condition_order,
     condition_palette,
@@ -67,16 +67,16 @@ SKILL_LABEL = "held-out decoding skill"
 POWER_LABEL = "wideband power (1/Hz)"
 
 
-def analysis_config(tables: Tables, assay: str) -> AnalysisConfig:
-    """The analysis settings (``cfg.analysis``) the run recorded with ``assay``'s conditions (its control's):
-    thresholds named on a panel follow the run's overrides, not the schema's defaults."""
-    return next(iter(assay_conditions(tables, assay).values())).analysis
+def dynamics_settings(tables: Tables, assay: str) -> AnalysisConfig:
+    """The analysis settings the dynamics job of ``assay`` ran with (its ``analysis_settings.parquet``): thresholds
+    named on a panel are those its tables were computed under, not the schema's defaults."""
+    return analysis_settings(tables, "dynamics", assay)
 
 
 def dimensionality_box(tables: Tables, ax) -> None:
     """Panel A: D_eff and the number of PCs reaching the variance fraction, per agent-episode of patchy4."""
     dims = tables["dims"]
-    share = analysis_config(tables, "patchy4").variance_fraction
+    share = dynamics_settings(tables, "patchy4").variance_fraction
     names = {"d_eff": "D_eff", "pcs_for_variance": f"PCs for {share:.0%} var."}
     long = dims.melt(id_vars=[c for c in dims.columns if c not in names], value_vars=list(names),
                      var_name="measure", value_name="dimensions")
@@ -208,7 +208,7 @@ def food_decoding_bars(tables: Tables, ax) -> None:
     sns.barplot(data=scored, x=SKILL, y="label", hue="food", hue_order=ranges, palette=FOOD_RANGE_COLOURS,
                 orient="h", errorbar=None, ax=ax)
     ax.axvline(0.0, color="black", lw=0.5)
-    near = analysis_config(tables, "wide2").claims_food_near_cm
+    near = dynamics_settings(tables, "wide2").claims_food_near_cm
     ax.legend(title=f"food (near: <= {near:g} cm)", fontsize=6, title_fontsize=6, loc="best")
     ax.set_xlabel(SKILL_LABEL)
     ax.set_ylabel("decoded variable")
@@ -291,7 +291,7 @@ def power_near_far(tables: Tables, ax) -> None:
     wide = wide.reindex(columns=order).dropna()
     ax.plot([0, 1], wide.to_numpy(float).T, color=NEUTRAL_COLOUR, lw=0.3, alpha=0.5, zorder=1)
     _pair_bracket(ax, frame, "wideband_power", tables["tests"], "near_far")
-    a = analysis_config(tables, "wide2")
+    a = dynamics_settings(tables, "wide2")
     ax.set_xticks([0, 1], [f"near (<= {a.claims_near_cm:g} cm)", f"far (> {a.claims_far_cm:g} cm)"])
     ax.set_xlabel("nearest conspecific (wide2)")
     ax.set_ylabel(label)

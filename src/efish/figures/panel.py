@@ -3,11 +3,14 @@
 Each figure module (``fig1`` ... ``fig6``, ``supplement``) ends with a list
 ``PANELS`` of these; :mod:`efish.figures.registry` gathers them. A panel
 draws on one matplotlib axes (``projection`` picks e.g. a polar one) from a
-dict of tables keyed like its :attr:`Panel.tables`: its ``inputs`` and, for
+dict of tables keyed like its :attr:`Panel.tables`: its ``inputs``; for
 every assay it reads, that assay's ``conditions.parquet`` under
 ``conditions/<assay>`` (what each condition resolved to in the run: roles,
-sizes, arena, fps), so that a panel draws what the run simulated and never
-composes a config of its own. A schematic panel reads nothing (``inputs={}``).
+sizes, arena, fps); and for every analysis table it reads, the settings that
+analysis job ran with (``analysis_settings.parquet``) under
+``settings/<analysis>/<assay>`` (the thresholds the table was computed under),
+so that a panel draws what the run simulated and analysed and never composes
+a config of its own. A schematic panel reads nothing (``inputs={}``).
 """
 
 from __future__ import annotations
@@ -26,6 +29,12 @@ Tables = dict[str, pd.DataFrame]
 def conditions_key(assay: str) -> str:
     """The key under which a panel's tables hold the conditions table of ``assay``: ``conditions/<assay>``."""
     return f"conditions/{assay}"
+
+
+def settings_key(analysis: str, assay: str) -> str:
+    """The key under which a panel's tables hold the settings analysis ``analysis`` of ``assay`` ran with:
+    ``settings/<analysis>/<assay>``."""
+    return f"settings/{analysis}/{assay}"
 
 
 #: Characters that start inline markup in reStructuredText (``|E|`` would be a substitution reference, ``*x*``
@@ -80,6 +89,15 @@ class Panel:
         return {conditions_key(assay): layout.assay_table(assay, "conditions") for assay in sorted(self.assays())}
 
     @property
+    def settings(self) -> dict[str, str]:
+        """The settings of every analysis job whose tables this panel reads: ``settings/<analysis>/<assay>`` -> its
+        ``analysis_settings.parquet``."""
+        jobs = {(t.analysis, t.assay) for path in self.inputs.values()
+                if (t := layout.parse_table(path)) and t.kind == "analysis"}
+        return {settings_key(*job): layout.analysis_settings(*job) for job in sorted(jobs)}
+
+    @property
     def tables(self) -> dict[str, str]:
-        """Every table the panel reads, name -> relative path: its ``inputs``, then :attr:`conditions`."""
-        return {**self.inputs, **self.conditions}
+        """Every table the panel reads, name -> relative path: its ``inputs``, then :attr:`conditions` and
+        :attr:`settings`."""
+        return {**self.inputs, **self.conditions, **self.settings}

@@ -33,12 +33,13 @@ def input_paths(panel: Panel, results: Path, seeds: Seeds) -> dict[str, list[Pat
 
 def check_inputs(panel: Panel, results: Path, seeds: Seeds) -> None:
     """One clear error naming the first table of ``panel`` that does not exist (a missing conditions table: rerun
-    the assay, which writes it)."""
+    the assay, which writes it; a missing settings table: rerun the analysis)."""
     for name, paths in input_paths(panel, results, seeds).items():
         for path in paths:
             if not path.is_file():
-                hint = "rerun the assay, which records its conditions" if name in panel.conditions else \
-                    "run the pipeline first"
+                hint = ("rerun the assay, which records its conditions" if name in panel.conditions else
+                        "rerun the analysis, which records its settings" if name in panel.settings else
+                        "run the pipeline first")
                 raise ValueError(f"panel {panel.key} needs {path}, which does not exist ({hint})")
 
 

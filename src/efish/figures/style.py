@@ -15,9 +15,9 @@ import numpy as np
 import pandas as pd
 
 from .. import layout
-from ..config.recorded import recorded_conditions
-from ..config.schema import EfishConfig
-from .panel import conditions_key
+from ..config.recorded import recorded_conditions, recorded_settings
+from ..config.schema import AnalysisConfig, EfishConfig
+from .panel import conditions_key, settings_key
 
 AGENT_COLOURS = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#F0E442", "#000000")
 RECEPTOR_COLOURS = {"mormyromast": "#0072B2", "ampullary": "#009E73", "knollenorgan": "#D55E00"}
@@ -250,6 +250,18 @@ def assay_conditions(tables: Mapping[str, pd.DataFrame], assay: str) -> Mapping[
                          f"conditions but no other table of it names {path} in its inputs; an older run lacks "
                          "the file: rerun the assay")
     return recorded_conditions(tables[key], path)
+
+
+def analysis_settings(tables: Mapping[str, pd.DataFrame], analysis: str, assay: str) -> AnalysisConfig:
+    """The analysis settings (``cfg.analysis``) the job of ``analysis`` on ``assay`` ran with, from the panel's
+    ``settings/<analysis>/<assay>`` table (its ``analysis_settings.parquet``,
+    :attr:`efish.figures.panel.Panel.settings`): a threshold a panel names is the one its table was computed
+    under, whatever the assay recorded or the schema says."""
+    key, path = settings_key(analysis, assay), layout.analysis_settings(analysis, assay)
+    if key not in tables:
+        raise ValueError(f"the panel's tables hold no {key} ({path}): a panel reads the settings of the analyses "
+                         "whose tables it names; an older run lacks the file: rerun the analysis")
+    return recorded_settings(tables[key], path)
 
 
 def condition_order(tables: Mapping[str, pd.DataFrame], assay: str, present, control=None) -> list:
