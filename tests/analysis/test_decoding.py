@@ -25,7 +25,7 @@ from efish.analysis.decoding import (
 from efish.analysis.registry import run
 from efish.rollout.schema import COLUMNS
 
-from ..helpers import cfg_with, rollout_tables
+from ..helpers import cfg_with, conditions_of, recorded_table, rollout_tables
 
 
 def planted(rng, n_episodes=12, per=50, d=20):
@@ -196,7 +196,8 @@ def test_the_dynamics_analysis_draws_the_mean_of_the_episodes_the_claims_test(as
     tables = rollout_tables(conditions=("electric", "raycast") if assay == "homing" else ("control",),
                             n_agents=2, episodes=4, error_angles=True)
     cfg = cfg_with("scale=smoke", f"assay={assay}")
-    out = run("dynamics", tables, cfg)
+    record = conditions_of("homing") if assay == "homing" else recorded_table(("control",))
+    out = run("dynamics", {**tables, "conditions": record}, cfg.analysis)
     pd.testing.assert_frame_equal(out["decoding"], summarise(out["decoding_episodes"]))
     pd.testing.assert_frame_equal(out["food_decoding"], summarise(out["food_decoding_episodes"], by=("food",)))
     homer = 1 - cfg.env.homing_target if assay == "homing" else None
