@@ -51,20 +51,19 @@ def c4(ctx: Context) -> list[Part]:
 WIDE2_STEPS, WIDE2_CONDITIONS = assay_table("wide2", "steps"), assay_table("wide2", "conditions")
 
 
-def _friedman_w(per: pd.DataFrame) -> tuple[float, float, int, int]:
+def _friedman_w(rates: np.ndarray) -> tuple[float, float, int, int]:
     """Friedman test of the episodes' mean EOD rates across distance bins, the episode a block (rule 1):
     Kendall's W = chi2 / (n (k - 1)), p, n episodes, k bins; NaN where undefined.
 
-    ``per``: one row per (condition, episode, bin) with ``rate``. Only the bins at least half the episodes reach
+    ``rates``: one row per episode (a bootstrap's episode drawn twice is two rows, two blocks), one column per
+    distance bin, NaN where the episode does not reach the bin. Only the bins at least half the episodes reach
     are compared, over the episodes that reach all of them (Friedman needs complete blocks)."""
-    # a bootstrap resample numbers its drawn episodes (_draw): an episode drawn twice is two blocks
-    blocks = ["_draw"] if "_draw" in per.columns else ["condition", "episode"]
-    wide = per.pivot_table(index=blocks, columns="bin", values="rate")
-    wide = wide.loc[:, wide.notna().mean() >= 0.5].dropna()
+    wide = rates[:, np.isfinite(rates).mean(axis=0) >= 0.5] if rates.size else rates
+    wide = wide[np.isfinite(wide).all(axis=1)]
     n, k = wide.shape
-    if k < 3 or n < 2 or np.all(wide.to_numpy() == wide.to_numpy()[:, :1]):
+    if k < 3 or n < 2 or np.all(wide == wide[:, :1]):
         return np.nan, np.nan, n, k
-    chi2, p = sps.friedmanchisquare(*wide.to_numpy().T)
+    chi2, p = sps.friedmanchisquare(*wide.T)
     return float(chi2 / (n * (k - 1))), float(p), n, k
 
 
@@ -87,11 +86,14 @@ def c5(ctx: Context) -> list[Part]:
         per = per.groupby(["condition", "episode", "bin"], as_index=False)["rate"].mean()
         if per.empty:
             raise ValueError(f"no agent-episode has {a.min_samples} steps in a {to} distance bin")
-        w, p, n, k = _friedman_w(per)
+        # one row per episode, one column per bin: a bootstrap resample then only picks rows
+        wide = per.pivot_table(index=["condition", "episode"], columns="bin", values="rate").reset_index()
+        bins = [c for c in wide.columns if c not in ("condition", "episode")]
+        w, p, n, k = _friedman_w(wide[bins].to_numpy(np.float64))
         reason = (f"{k} distance bins over {n} episodes that reach them all" if np.isfinite(p) else
                   "fewer than 3 distance bins reached by half the episodes, fewer than 2 such episodes, "
                   "or a constant rate")
-        return Outcome(w, p, n, None, ctx.ci(per, lambda d: _friedman_w(d)[0]), reason)
+        return Outcome(w, p, n, None, ctx.ci(wide, lambda d: _friedman_w(d[bins].to_numpy(np.float64))[0]), reason)
     stat = ("Friedman test of the episodes' mean EOD rate across the distance bins of "
             "docs/methods/analyses.md#analysis-signalling (wide2), the episode a block; effect Kendall's W")
     return [ctx.part(to, stat, functools.partial(compute, to)) for to in ("agent", "food", "wall")]
