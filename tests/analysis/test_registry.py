@@ -122,9 +122,12 @@ def test_settings_and_the_recorded_rate_reach_the_functions(tables, tmp_path):
     pd.DataFrame({"idi_ms": (np.random.default_rng(1).pareto(1.5, 2000) + 1) * 20.0}).to_csv(real, index=False)
     default = run("signalling", tables, cfg_with().analysis)
     assert default["power_law"].set_index("source").loc["real_fish", "reason"].startswith("no real-fish IDI table")
-    settings = cfg_with("analysis.rate_bins=4", "analysis.idi_bins=7", f"analysis.real_fish_idis={real}").analysis
+    settings = cfg_with("analysis.rate_bins=4", "analysis.idi_bins=7", f"analysis.real_fish_idis={real}",
+                        "analysis.claims_event_window=[-5,20]", "analysis.claims_baseline_window=[-60,-30]").analysis
     out = run("signalling", {**tables, "conditions": recorded_table(("control", "treated"), "env.fps=100")}, settings)
-    assert out["rate_by_distance"]["bin"].max() <= 3
+    assert out["rate_by_distance"]["bin"].max() <= 3 and out["rate_by_distance_episodes"]["bin"].max() <= 3
+    windows = out["peri_event_episodes"][["event_lo", "event_hi", "baseline_lo", "baseline_hi"]].drop_duplicates()
+    assert windows.values.tolist() == [[-5, 20, -60, -30]]  # claim C6's windows are the analysis job's
     assert out["idi_histogram"].groupby(["source", "condition"], dropna=False).size().eq(7).all()
     assert np.isfinite(out["power_law"].set_index("source").loc["real_fish", "alpha"])
     np.testing.assert_allclose(out["idis"]["idi_ms"], out["idis"]["idi_steps"] * 10.0)  # 1000 / env.fps
@@ -149,6 +152,12 @@ def test_a_planted_eod_rate_comes_out_in_hz_at_each_recorded_frame_rate():
         peri = of(out["peri_event"], cond).dropna(subset=["mean_hz"])
         assert len(peri) and peri["mean_hz"].to_numpy() == pytest.approx(rate / 5)
         np.testing.assert_allclose(peri["lag_ms"], peri["lag"] * 1000.0 / rate)
+        # per episode (claims C5, C6): the same rate in every bin, and no change around eating
+        episodes = of(out["rate_by_distance_episodes"], cond).dropna(subset=["rate_hz"])
+        assert len(episodes) and episodes["rate_hz"].to_numpy() == pytest.approx(rate / 5)
+        change = of(out["peri_event_episodes"], cond)
+        change = change[change["event"] == "ate"]
+        assert len(change) == 3 and change["change_hz"].to_numpy() == pytest.approx(0.0, abs=1e-9)
         ids = of(out["idis"], cond)
         assert (ids["idi_steps"] == 5).all() and ids["idi_ms"].to_numpy() == pytest.approx(5000.0 / rate)
         fit = of(out["power_law"], cond).iloc[0]  # the agents' fit (the real fish's has no condition)

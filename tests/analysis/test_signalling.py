@@ -7,11 +7,15 @@ import pandas as pd
 import pytest
 
 from efish.analysis.signalling import (
+    EPISODE_BIN_COLUMNS,
+    PERI_EPISODE_COLUMNS,
     eod_rate_by_distance,
+    eod_rate_by_distance_episodes,
     fit_power_law,
     idi_histogram,
     idis,
     load_real_idis,
+    peri_event_episodes,
     peri_event_rate,
     rate_advantage_vs_size,
     xmin_in_steps,
@@ -119,6 +123,39 @@ def test_eod_rate_by_distance_degenerate_and_errors():
         eod_rate_by_distance(agent_steps(np.ones(50)).drop(columns="dist_agent_cm"), "agent", fps=FPS)
 
 
+def test_eod_rate_by_distance_episodes_averages_each_episodes_agents():
+    """Per episode and bin: each agent's mean rate over its steps in the bin, then their mean. Episode 0: agent 0
+    fires on every step (83 Hz) and agent 1 never, both 1 cm from food (bin 1): 41.5 Hz from 2 agents; agent 1 also
+    spends 3 steps at 5 cm (bin 7), too few (< 5): left out. Episode 1: one agent fires on every other step at 9 cm
+    (bin 13): 41.5 Hz."""
+    t = 100
+    middle = np.where((np.arange(t) >= 40) & (np.arange(t) < 43), 5.0, 1.0)
+    steps = pd.concat([agent_steps(np.ones(t), dist_food_cm=1.0), agent_steps(np.zeros(t), agent=1, dist_food_cm=middle),
+                       agent_steps(np.arange(t) % 2 == 0, episode=1, dist_food_cm=9.0)], ignore_index=True)
+    out = eod_rate_by_distance_episodes(steps, "food", fps=FPS)
+    assert list(out.columns) == EPISODE_BIN_COLUMNS and (out["reason"] == "").all() and (out["to"] == "food").all()
+    assert out[["episode", "bin", "n_agents"]].values.tolist() == [[0, 1, 2], [1, 13, 1]]
+    assert out["rate_hz"].tolist() == pytest.approx([41.5, 41.5])
+    assert out.loc[0, "bin_lo_cm"] == pytest.approx(2 / 3) and out.loc[1, "bin_hi_cm"] == pytest.approx(28 / 3)
+    # one agent-episode: the per-episode rates are eod_rate_by_distance's means (the same rates, bins and steps)
+    one = agent_steps(np.random.default_rng(3).random(400) < 0.3, dist_food_cm=np.linspace(0, 10, 400))
+    pooled, episodes = eod_rate_by_distance(one, "food", fps=FPS), eod_rate_by_distance_episodes(one, "food", fps=FPS)
+    assert episodes["bin"].tolist() == pooled["bin"].tolist() and len(pooled) == 15
+    assert episodes["rate_hz"].tolist() == pooled["mean_hz"].tolist()
+    assert episodes["bin_mid_cm"].tolist() == pooled["bin_mid_cm"].tolist()
+
+
+def test_eod_rate_by_distance_episodes_degenerate_and_errors():
+    far = pd.concat([agent_steps(np.ones(50), dist_food_cm=np.nan), agent_steps(np.ones(50)).assign(condition="d")])
+    out = eod_rate_by_distance_episodes(far, "food", fps={"c": FPS, "d": FPS})
+    assert out["condition"].tolist() == ["c", "d"] and np.isnan(out.loc[0, "rate_hz"])
+    assert out.loc[0, "reason"] == "no agent-episode has 5 steps in a food distance bin" and out.loc[0, "n_agents"] == 0
+    empty = eod_rate_by_distance_episodes(agent_steps([]), "wall", fps=FPS)
+    assert len(empty) == 1 and empty.loc[0, "reason"] == "empty steps table" and list(empty.columns) == EPISODE_BIN_COLUMNS
+    with pytest.raises(ValueError, match="to must be one of"):
+        eod_rate_by_distance_episodes(agent_steps(np.ones(50)), "pellet", fps=FPS)
+
+
 def test_peri_event_rate_rises_after_events():
     t, events = 1000, [200, 450, 700]
     ate, eod = np.zeros(t, bool), np.zeros(t, bool)
@@ -164,3 +201,46 @@ def test_load_real_idis(tmp_path):
         load_real_idis(tmp_path / "bad.csv")
     with pytest.raises(FileNotFoundError):
         load_real_idis(tmp_path / "absent.csv")
+
+
+def firing_after_events(agent=0, episode=0, fires=True, events=(200, 450, 700), t=1000) -> pd.DataFrame:
+    """An agent-episode that eats at ``events`` and discharges on every step of the 40 after each (``fires``) or
+    never."""
+    ate, eod = np.zeros(t, bool), np.zeros(t, bool)
+    for e in events:
+        ate[e] = True
+        eod[e:e + 40] = fires
+    return agent_steps(eod, agent=agent, episode=episode, ate=ate)
+
+
+def test_peri_event_episodes_is_the_change_of_the_agents_mean_rate():
+    """Lags 15-25 after eating see a full window of discharges (83 Hz), lags -80 to -50 none: a change of 83 Hz
+    for an agent that fires after eating and 0 for one that never does; episode 0 has both (41.5 Hz from 2
+    agents), episode 1 the firing one alone; an agent-episode with 2 events (< 3) is left out."""
+    steps = pd.concat([firing_after_events(), firing_after_events(agent=1, fires=False),
+                       firing_after_events(episode=1), firing_after_events(agent=1, episode=1, events=(200, 450))])
+    out = peri_event_episodes(steps, "ate", (15, 25), (-80, -50), fps=FPS)
+    assert list(out.columns) == PERI_EPISODE_COLUMNS and (out["reason"] == "").all()
+    assert out[["episode", "n_agents"]].values.tolist() == [[0, 2], [1, 1]]
+    assert out["change_hz"].tolist() == pytest.approx([41.5, 83.0])
+    assert out[["event", "event_lo", "event_hi", "baseline_lo", "baseline_hi"]].drop_duplicates().values.tolist() == [
+        ["ate", 15, 25, -80, -50]]
+    # the curves are peri_event_rate's: one agent-episode's change is the difference of its curve's window means
+    noisy = firing_after_events().assign(eod=np.random.default_rng(2).random(1000) < 0.4)
+    curve = peri_event_rate(noisy, "ate", fps=FPS).set_index("lag")["mean_hz"]
+    (change,) = peri_event_episodes(noisy, "ate", (-10, 10), (-100, -50), fps=FPS)["change_hz"]
+    assert change == pytest.approx(curve.loc[-10:10].mean() - curve.loc[-100:-50].mean(), abs=1e-12)
+
+
+def test_peri_event_episodes_degenerate_and_errors():
+    few = pd.concat([firing_after_events(events=(200, 450)), firing_after_events().assign(condition="d")])
+    out = peri_event_episodes(few, "ate", fps={"c": FPS, "d": FPS})
+    assert out["condition"].tolist() == ["c", "d"] and np.isnan(out.loc[0, "change_hz"])
+    assert out.loc[0, "reason"] == "no agent-episode has 3 or more 'ate' events" and out.loc[0, "n_agents"] == 0
+    beyond = peri_event_episodes(few, "ate", (-10, 10), (-150, -50), fps={"c": FPS, "d": FPS})
+    assert beyond["change_hz"].isna().all() and len(beyond) == 2
+    assert (beyond["reason"] == "the windows reach beyond analysis.peri_window = 100 steps").all()
+    empty = peri_event_episodes(agent_steps([]), "bit", fps=FPS)
+    assert len(empty) == 1 and empty.loc[0, "reason"] == "empty steps table"
+    with pytest.raises(ValueError, match="event must be one of"):
+        peri_event_episodes(few, "eaten", fps=FPS)

@@ -55,10 +55,12 @@ from .onepatch import food_from_steps, reach_tests, role_tests
 from .signalling import (
     EVENTS,
     eod_rate_by_distance,
+    eod_rate_by_distance_episodes,
     fit_power_law,
     idi_histogram,
     idis,
     load_real_idis,
+    peri_event_episodes,
     peri_event_rate,
     rate_advantage_vs_size,
     xmin_in_steps,
@@ -160,19 +162,26 @@ def _idi_tables(ids: pd.DataFrame, present: Iterable, a: AnalysisConfig, fps: Ma
 
 
 def _signalling(t: Tables, a: AnalysisConfig, conditions: Conditions) -> Tables:
-    """IDIs, their histograms and power laws, EOD rate vs distance and around events, rate vs size (Fig 3C-J,P),
-    each condition in its recorded steps per second."""
+    """IDIs, their histograms and power laws, EOD rate vs distance and around events, also per episode (claims C5,
+    C6), rate vs size (Fig 3C-J,P), each condition in its recorded steps per second."""
     steps, fps = t["steps"], step_rates(conditions)
     ranges = {"agent": a.agent_range_cm, "food": a.food_range_cm, "wall": a.wall_range_cm}
     ids, advantage = idis(steps, fps=fps), rate_advantage_vs_size(steps, a.bout_cm, a.rate_window, fps=fps)
+
+    def by_distance(per) -> pd.DataFrame:
+        return pd.concat([per(steps, to, a.rate_bins, (0.0, hi), a.min_samples, a.rate_window, fps=fps)
+                          for to, hi in ranges.items()], ignore_index=True)
     return {
         "idis": or_nan_row(ids, "no agent discharged twice"),
         **_idi_tables(ids, steps["condition"].unique(), a, fps),
-        "rate_by_distance": pd.concat([eod_rate_by_distance(steps, to, a.rate_bins, (0.0, hi), a.min_samples,
-                                                            a.rate_window, fps=fps) for to, hi in ranges.items()],
-                                      ignore_index=True),
+        "rate_by_distance": by_distance(eod_rate_by_distance),
+        "rate_by_distance_episodes": by_distance(eod_rate_by_distance_episodes),
         "peri_event": pd.concat([peri_event_rate(steps, e, a.peri_window, a.min_events, a.rate_window, fps=fps)
                                  for e in EVENTS], ignore_index=True),
+        "peri_event_episodes": pd.concat([peri_event_episodes(steps, e, a.claims_event_window,
+                                                              a.claims_baseline_window, a.peri_window, a.min_events,
+                                                              a.rate_window, fps=fps) for e in EVENTS],
+                                         ignore_index=True),
         "rate_advantage": advantage,
         "rate_tests": spearman(advantage, "size_advantage", "rate_advantage_hz", by="condition"),
     }
@@ -286,8 +295,8 @@ FORAGING = ("patchy4", "uniform4", "ablation4", "ablation1", "collective", "mute
             "groupsize", "onepatch")
 ANALYSES: dict[str, Analysis] = {a.name: a for a in [
     Analysis("signalling", _signalling, ("steps", "conditions"), ("patchy4", "wide2"),
-             ("idis", "idi_histogram", "power_law", "rate_by_distance", "peri_event", "rate_advantage",
-              "rate_tests"), ("rate_tests",)),
+             ("idis", "idi_histogram", "power_law", "rate_by_distance", "rate_by_distance_episodes", "peri_event",
+              "peri_event_episodes", "rate_advantage", "rate_tests"), ("rate_tests",)),
     Analysis("behaviour", _behaviour, ("steps", "episodes", "conditions"), FORAGING,
              ("food_per_agent", "food_vs_size", "theil", "win_ratio", "bite_matrix", "nearest_neighbour",
               "eod_probability", "episode_summary", "size_tests", "condition_tests"),

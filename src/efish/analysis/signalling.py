@@ -237,16 +237,37 @@ def load_real_idis(path: str | Path | None) -> pd.DataFrame:
 
 
 BIN_COLUMNS = ["condition", "to", "bin", "bin_lo_cm", "bin_hi_cm", "bin_mid_cm", "n", "mean_hz", "sem_hz", "reason"]
+#: Columns of :func:`eod_rate_by_distance_episodes`: one row per (condition, episode, to, bin).
+EPISODE_BIN_COLUMNS = ["condition", "episode", "to", "bin", "bin_lo_cm", "bin_hi_cm", "bin_mid_cm", "n_agents",
+                       "rate_hz", "reason"]
 
 
-def _binned_mean_sem(values: np.ndarray, x: np.ndarray, edges: np.ndarray, min_samples: int) -> pd.DataFrame:
-    ok = np.isfinite(values) & np.isfinite(x) & (x >= edges[0]) & (x <= edges[-1])
-    idx = np.clip(np.searchsorted(edges, x[ok], side="right") - 1, 0, len(edges) - 2)  # x = hi goes in the last
-    table = pd.DataFrame({"bin": idx, "v": values[ok]}).groupby("bin")["v"].agg(["size", "mean", "sem"])
+def _distance_bins(steps: pd.DataFrame, to: str, bins: int, range_cm: tuple[float, float] | None, window: int,
+                   fps: PerCondition) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The ``bins`` + 1 equal edges of the distance to the nearest ``to``, and every step's EOD rate (Hz) and distance
+    bin: -1 where the step has no rate (no full window) or its distance is NaN or outside the edges; a distance on
+    the last edge is in the last bin."""
+    if to not in DISTANCE_RANGES_CM:
+        raise ValueError(f"to must be one of {sorted(DISTANCE_RANGES_CM)}, got {to!r}")
+    column = f"dist_{to}_cm"
+    require(steps, ["condition", column], "steps table")
+    edges = np.linspace(*(range_cm or DISTANCE_RANGES_CM[to]), bins + 1)
+    rate, dist = eod_rate(steps, window, fps=fps), steps[column].to_numpy(np.float64)
+    inside = np.isfinite(rate) & np.isfinite(dist) & (dist >= edges[0]) & (dist <= edges[-1])
+    return edges, rate, np.where(inside, np.clip(np.searchsorted(edges, dist, side="right") - 1, 0, bins - 1), -1)
+
+
+def _bin_edges(edges: np.ndarray, b: np.ndarray) -> dict[str, np.ndarray]:
+    """The lower, upper and middle edge (cm) of the bins ``b``."""
+    return {"bin_lo_cm": edges[b], "bin_hi_cm": edges[b + 1], "bin_mid_cm": (edges[b] + edges[b + 1]) / 2}
+
+
+def _binned_mean_sem(values: np.ndarray, b: np.ndarray, edges: np.ndarray, min_samples: int) -> pd.DataFrame:
+    """Size, mean and SEM of ``values`` per bin ``b`` (-1: none), bins with fewer than ``min_samples`` dropped."""
+    table = pd.DataFrame({"bin": b[b >= 0], "v": values[b >= 0]}).groupby("bin")["v"].agg(["size", "mean", "sem"])
     table = table[table["size"] >= min_samples]
     b = table.index.to_numpy()
-    return pd.DataFrame({"bin": b, "bin_lo_cm": edges[b], "bin_hi_cm": edges[b + 1],
-                         "bin_mid_cm": (edges[b] + edges[b + 1]) / 2, "n": table["size"].to_numpy(),
+    return pd.DataFrame({"bin": b, **_bin_edges(edges, b), "n": table["size"].to_numpy(),
                          "mean_hz": table["mean"].to_numpy(), "sem_hz": table["sem"].to_numpy(), "reason": ""})
 
 
@@ -259,17 +280,12 @@ def eod_rate_by_distance(steps: pd.DataFrame, to: str, bins: int = DEFAULTS.rate
     Ranges default to docs/methods/analyses.md#analysis-signalling: 0-150 cm for agents, 0-10 cm for food and wall.
     Samples are steps (every agent-step with a full rate window), per condition;
     bins with fewer than ``min_samples`` steps are dropped. A condition with no
-    bin left gets one NaN row with a reason.
+    bin left gets one NaN row with a reason. Per episode: :func:`eod_rate_by_distance_episodes`.
     """
-    if to not in DISTANCE_RANGES_CM:
-        raise ValueError(f"to must be one of {sorted(DISTANCE_RANGES_CM)}, got {to!r}")
-    column = f"dist_{to}_cm"
-    require(steps, ["condition", column], "steps table")
-    edges = np.linspace(*(range_cm or DISTANCE_RANGES_CM[to]), bins + 1)
-    rate, dist = eod_rate(steps, window, fps=fps), steps[column].to_numpy(np.float64)
+    edges, rate, b = _distance_bins(steps, to, bins, range_cm, window, fps)
     parts = []
     for cond, idx in steps.groupby("condition", sort=True).indices.items():
-        table = _binned_mean_sem(rate[idx], dist[idx], edges, min_samples)
+        table = _binned_mean_sem(rate[idx], b[idx], edges, min_samples)
         if table.empty:
             table = nan_frame(f"no distance bin has {min_samples} or more samples", n=0)
         parts.append(table.assign(condition=cond, to=to))
@@ -278,12 +294,58 @@ def eod_rate_by_distance(steps: pd.DataFrame, to: str, bins: int = DEFAULTS.rate
     return pd.concat(parts, ignore_index=True).reindex(columns=BIN_COLUMNS)
 
 
+def eod_rate_by_distance_episodes(steps: pd.DataFrame, to: str, bins: int = DEFAULTS.rate_bins,
+                                  range_cm: tuple[float, float] | None = None,
+                                  min_samples: int = DEFAULTS.min_samples, window: int = DEFAULTS.rate_window, *,
+                                  fps: PerCondition) -> pd.DataFrame:
+    """Per episode and distance bin of :func:`eod_rate_by_distance` (the same rates, bins and steps): ``rate_hz``,
+    the mean over the episode's agents of each agent's mean EOD rate over its steps in the bin, and ``n_agents``
+    averaged; an agent-episode with fewer than ``min_samples`` steps in a bin leaves that bin out. The agents of
+    an episode are not independent, nor are its steps: the episode is the unit of claim C5
+    (docs/claims/index.md#c5). Columns :data:`EPISODE_BIN_COLUMNS`; a condition with no such bin gets one NaN row
+    with a reason.
+    """
+    edges, rate, b = _distance_bins(steps, to, bins, range_cm, window, fps)
+    frame = steps.loc[b >= 0, AGENT_EPISODE].assign(rate=rate[b >= 0], bin=b[b >= 0])
+    per = frame.groupby([*AGENT_EPISODE, "bin"])["rate"].agg(["mean", "size"])
+    per = per[per["size"] >= min_samples]["mean"].rename("rate").reset_index()
+    out = per.groupby(["condition", "episode", "bin"], as_index=False)["rate"].mean().rename(columns={"rate": "rate_hz"})
+    out["n_agents"] = per.groupby(["condition", "episode", "bin"]).size().to_numpy()
+    out = out.assign(to=to, **_bin_edges(edges, out["bin"].to_numpy()), reason="")
+    none = [nan_frame(f"no agent-episode has {min_samples} steps in a {to} distance bin", condition=cond, to=to,
+                      n_agents=0) for cond in sorted(set(steps["condition"]) - set(out["condition"]))]
+    if steps.empty:
+        none = [nan_frame("empty steps table", to=to, n_agents=0)]
+    out = pd.concat([out, *none], ignore_index=True).sort_values(["condition", "episode", "bin"], kind="stable")
+    return out.reset_index(drop=True).reindex(columns=EPISODE_BIN_COLUMNS)
+
+
 def _event_triggered(rate: np.ndarray, events: np.ndarray, lags: np.ndarray) -> np.ndarray:
     """Mean rate at t + lag over the events of one agent-episode; NaN where no event has a rate there."""
     idx = events[:, None] + lags[None, :]
     inside = (idx >= 0) & (idx < rate.size)
     vals = np.where(inside, rate[np.clip(idx, 0, rate.size - 1)], np.nan)
     return pd.DataFrame(vals).mean().to_numpy()  # pandas: a lag no event reaches is NaN, without a warning
+
+
+def _peri_event_curves(steps: pd.DataFrame, event: str, window: int, min_events: int, rate_window: int,
+                       fps: PerCondition) -> tuple[np.ndarray, dict]:
+    """The lags -``window``..``window`` and, per condition (sorted), its agent-episodes with at least
+    ``min_events`` events: their (episode, agent) keys and curves, each the agent-episode's mean EOD rate (Hz)
+    over its events at every lag (NaN where no event reaches one)."""
+    if event not in EVENTS:
+        raise ValueError(f"event must be one of {list(EVENTS)}, got {event!r}")
+    require(steps, [*AGENT_EPISODE, "t", event], "steps table")
+    lags = np.arange(-window, window + 1)
+    rate = eod_rate(steps, rate_window, fps=fps)
+    frame = steps[[*AGENT_EPISODE, "t", event]].assign(rate=rate).sort_values([*AGENT_EPISODE, "t"])
+    curves = {}
+    for cond, sub in frame.groupby("condition", sort=True):
+        units = [(key, g) for key, g in sub.groupby(["episode", "agent"], sort=True) if g[event].sum() >= min_events]
+        curves[cond] = ([key for key, _ in units],
+                        [_event_triggered(g["rate"].to_numpy(), np.flatnonzero(g[event].to_numpy(bool)), lags)
+                         for _, g in units])
+    return lags, curves
 
 
 def peri_event_rate(steps: pd.DataFrame, event: str, window: int = DEFAULTS.peri_window,
@@ -296,18 +358,11 @@ def peri_event_rate(steps: pd.DataFrame, event: str, window: int = DEFAULTS.peri
     Each agent-episode with at least ``min_events`` events contributes its mean
     over events at every lag; the mean and SEM are across those agent-episodes
     (``n_agents``), per condition. Without any such agent-episode the condition
-    gets one NaN row with a reason.
+    gets one NaN row with a reason. Per episode, the change from a baseline: :func:`peri_event_episodes`.
     """
-    if event not in EVENTS:
-        raise ValueError(f"event must be one of {list(EVENTS)}, got {event!r}")
-    require(steps, [*AGENT_EPISODE, "t", event], "steps table")
-    lags = np.arange(-window, window + 1)
-    rate = eod_rate(steps, rate_window, fps=fps)
-    frame = steps[[*AGENT_EPISODE, "t", event]].assign(rate=rate).sort_values([*AGENT_EPISODE, "t"])
+    lags, per_condition = _peri_event_curves(steps, event, window, min_events, rate_window, fps)
     parts = []
-    for cond, sub in frame.groupby("condition", sort=True):
-        curves = [_event_triggered(g["rate"].to_numpy(), np.flatnonzero(g[event].to_numpy(bool)), lags)
-                  for _, g in sub.groupby(["episode", "agent"], sort=True) if g[event].sum() >= min_events]
+    for cond, (_, curves) in per_condition.items():
         if not curves:
             parts.append(nan_frame(f"no agent-episode has {min_events} or more '{event}' events",
                                    condition=cond, lag=np.nan, n_agents=0, mean_hz=np.nan, sem_hz=np.nan))
@@ -321,6 +376,58 @@ def peri_event_rate(steps: pd.DataFrame, event: str, window: int = DEFAULTS.peri
     out = pd.concat(parts, ignore_index=True).assign(event=event)
     out["lag_ms"] = out["lag"] * 1000.0 / values_of(fps, out["condition"])
     return out
+
+
+#: Columns of :func:`peri_event_episodes`: one row per (condition, episode, event).
+PERI_EPISODE_COLUMNS = ["condition", "episode", "event", "n_agents", "change_hz", "event_lo", "event_hi",
+                        "baseline_lo", "baseline_hi", "reason"]
+
+
+def peri_event_episodes(steps: pd.DataFrame, event: str, event_window: Sequence[int] = (-10, 10),
+                        baseline_window: Sequence[int] = (-100, -50), window: int = DEFAULTS.peri_window,
+                        min_events: int = DEFAULTS.min_events, rate_window: int = DEFAULTS.rate_window, *,
+                        fps: PerCondition) -> pd.DataFrame:
+    """Per episode, how much its agents' EOD rate (Hz) changes around an ``event``: ``change_hz``, the mean over
+    the episode's agent-episodes with at least ``min_events`` events (``n_agents`` of them) of the mean of its
+    peri-event curve (:func:`peri_event_rate`'s, the same curves) at the lags of ``event_window`` minus that at
+    the lags of ``baseline_window`` (both inclusive, in steps; ``event_lo`` .. ``baseline_hi``). An agent-episode
+    with no rate in either window is left out; the episode is the unit of claim C6 (docs/claims/index.md#c6).
+
+    Columns :data:`PERI_EPISODE_COLUMNS`. A condition without such an agent-episode gets one NaN row with a
+    reason, as does every condition when a window reaches beyond ``window``.
+    """
+    (e0, e1), (b0, b1) = event_window, baseline_window
+    bounds = {"event": event, "event_lo": e0, "event_hi": e1, "baseline_lo": b0, "baseline_hi": b1}
+    if max(abs(e0), abs(e1), abs(b0), abs(b1)) > window:
+        conds = sorted(steps["condition"].unique()) if "condition" in steps.columns else []
+        return pd.concat([nan_frame(f"the windows reach beyond analysis.peri_window = {window} steps",
+                                    condition=c, n_agents=0, **bounds) for c in conds or [np.nan]],
+                         ignore_index=True).reindex(columns=PERI_EPISODE_COLUMNS)
+    lags, per_condition = _peri_event_curves(steps, event, window, min_events, rate_window, fps)
+    parts = []
+    for cond, (keys, curves) in per_condition.items():
+        if not curves:
+            parts.append(nan_frame(f"no agent-episode has {min_events} or more '{event}' events", condition=cond,
+                                   n_agents=0, **bounds))
+            continue
+        episode, agent = (np.repeat([k[i] for k in keys], lags.size) for i in (0, 1))
+        # the lags no event reaches are dropped, not left to the mean to skip: pandas' groupby mean sums in
+        # another order around a NaN, so the same numbers would differ in the last bits
+        frame = pd.DataFrame({"episode": episode, "agent": agent, "lag": np.tile(lags, len(keys)),
+                              "rate": np.concatenate(curves)}).dropna(subset=["rate"])
+        near, base = (frame[(frame["lag"] >= lo) & (frame["lag"] <= hi)].groupby(["episode", "agent"])["rate"].mean()
+                      for lo, hi in ((e0, e1), (b0, b1)))
+        change = (near - base).dropna().rename("change_hz").reset_index()
+        if change.empty:
+            parts.append(nan_frame(f"no agent-episode with {min_events} or more '{event}' events has a rate in "
+                                   "both windows", condition=cond, n_agents=0, **bounds))
+            continue
+        per = change.groupby("episode", as_index=False)["change_hz"].mean()  # the agents of one episode: one unit
+        per["n_agents"] = change.groupby("episode").size().to_numpy()
+        parts.append(per.assign(condition=cond, reason="", **bounds))
+    if not parts:
+        parts = [nan_frame("empty steps table", condition=np.nan, n_agents=0, **bounds)]
+    return pd.concat(parts, ignore_index=True).reindex(columns=PERI_EPISODE_COLUMNS)
 
 
 def rate_advantage_vs_size(steps: pd.DataFrame, within_cm: float = DEFAULTS.bout_cm,
