@@ -137,12 +137,22 @@ def wide_steps(flip: bool, episodes: int = 8, steps: int = 600, null: bool = Fal
             p = np.full(steps, 0.3) if null else p
             rows.append(pd.DataFrame({"condition": "control", "episode": e, "agent": a, "t": np.arange(steps),
                                       "eod": rng.random(steps) < p, "ate": events, "bit": events,
-                                      "was_bitten": events, **{f"dist_{k}_cm": v for k, v in d.items()}}))
+                                      "was_bitten": events, "size": 0.5 + 0.1 * a, "x_cm": 10.0 + 80 * a,
+                                      "y_cm": 10.0, **{f"dist_{k}_cm": v for k, v in d.items()}}))
     return pd.concat(rows, ignore_index=True)
 
 
+def signalling_tables(steps: pd.DataFrame, recorded: pd.DataFrame | None = None) -> dict:
+    """The per-episode tables of wide2's signalling analysis that C5 and C6 read, run as the pipeline runs it: on
+    the ``steps`` and the conditions wide2 recorded (``recorded``; one control at the default env.fps when not
+    given), under the claims' analysis settings."""
+    recorded = recorded_table(("control",)) if recorded is None else recorded
+    out = run("signalling", {"steps": steps, "conditions": recorded}, CFG.analysis)
+    return {A("signalling", "wide2", t): out[t] for t in ("rate_by_distance_episodes", "peri_event_episodes")}
+
+
 def c5(flip):
-    return {R("wide2", "steps"): wide_steps(flip), R("wide2", "conditions"): recorded_table(("control",))}
+    return signalling_tables(wide_steps(flip))
 
 
 c6 = c5
@@ -560,7 +570,7 @@ def test_the_authors_self_only_mode_is_reported_beside_and_does_not_decide():
 
 def test_c6_without_a_planted_event_effect_is_weaker_with_a_proper_interval():
     """EOD probability unrelated to the events: no part holds or fails, and each interval spans 0 with a width."""
-    _, assessed = cl.CLAIMS["C6"].assess({**c6(False), R("wide2", "steps"): wide_steps(False, null=True)}, CFG)
+    _, assessed = cl.CLAIMS["C6"].assess(signalling_tables(wide_steps(False, null=True)), CFG)
     parts = pd.DataFrame(part_rows("C6", assessed), columns=PART_COLUMNS)
     assert (parts["verdict"] == "weaker").all(), parts[["part", "verdict", "reason"]]
     assert ((parts["ci_low"] < 0) & (parts["ci_high"] > 0)).all(), parts[["part", "ci_low", "ci_high"]]
@@ -568,9 +578,9 @@ def test_c6_without_a_planted_event_effect_is_weaker_with_a_proper_interval():
 
 def test_c5_and_c6_take_the_rate_that_wide2_recorded():
     """Issue 38: C6's change of the EOD rate around an event is in Hz of the frame rate the wide2 assay recorded
-    (conditions.parquet), not of a config: agents that discharge on every step within 30 steps of an event and never
-    otherwise change their rate by exactly fps Hz, 83 at the default env.fps and 41.5 at half of it. C5's Kendall's
-    W ranks the rates, so it is the same at both; without the record neither claim runs."""
+    (conditions.parquet), which the signalling analysis reads: agents that discharge on every step within 30 steps
+    of an event and never otherwise change their rate by exactly fps Hz, 83 at the default env.fps and 41.5 at half
+    of it. C5's Kendall's W ranks the rates, so it is the same at both."""
     steps = wide_steps(False)
     near = np.zeros(len(steps), bool)
     for event in (150, 300, 450):
@@ -578,16 +588,33 @@ def test_c5_and_c6_take_the_rate_that_wide2_recorded():
     steps = steps.assign(eod=near)
     c5_effects = []
     for fps in (DEFAULT_FPS, HALF_FPS):
-        recorded = recorded_table({"control": [f"env.fps={fps:g}"]})
-        tables = {R("wide2", "steps"): steps, R("wide2", "conditions"): recorded}
+        tables = signalling_tables(steps, recorded_table({"control": [f"env.fps={fps:g}"]}))
         parts = {p.label: p for p in cl.CLAIMS["C6"].assess(tables, CFG)[1]}
         for event in ("ate", "bit", "was_bitten"):
             assert parts[event].effect == pytest.approx(fps), (event, parts[event].reason)
         c5_effects.append([p.effect for p in cl.CLAIMS["C5"].assess(tables, CFG)[1]])
     assert c5_effects[0] == c5_effects[1] and np.isfinite(c5_effects[0]).all()
-    for cid in ("C5", "C6"):
-        row = cl.CLAIMS[cid].run({R("wide2", "steps"): steps}, CFG)
-        assert row["verdict"] == "not run" and "assays/wide2/conditions.parquet" in row["reason"], row["reason"]
+
+
+def test_c5_and_c6_only_select_the_analysis_rows():
+    """Issue 38: C5 and C6 read the signalling analysis's per-episode tables and nothing else: rows of another
+    condition or event do not move them, an analysis run with other windows than the claims' stops C6 (its
+    statistic would name the wrong lags), and a table of NaN rows stops them with the analysis's reason."""
+    tables = c5(False)
+    rates, change = (tables[A("signalling", "wide2", t)] for t in ("rate_by_distance_episodes", "peri_event_episodes"))
+    before = {cid: cl.CLAIMS[cid].assess(tables, CFG)[1] for cid in ("C5", "C6")}
+    assert set(cl.CLAIMS["C5"].tables) == {A("signalling", "wide2", "rate_by_distance_episodes")}
+    assert set(cl.CLAIMS["C6"].tables) == {A("signalling", "wide2", "peri_event_episodes")}
+    # the "food" rows shifted: only C5's food part moves
+    shifted = rates.assign(rate_hz=np.where(rates["to"] == "food", rates["rate_hz"] * rates["bin"], rates["rate_hz"]))
+    after = cl.CLAIMS["C5"].assess({**tables, A("signalling", "wide2", "rate_by_distance_episodes"): shifted}, CFG)[1]
+    assert [a.effect == b.effect for a, b in zip(before["C5"], after, strict=True)] == [True, False, True]
+    other = change.assign(event_lo=change["event_lo"] - 1)
+    parts = cl.CLAIMS["C6"].assess({**tables, A("signalling", "wide2", "peri_event_episodes"): other}, CFG)[1]
+    assert all(p.verdict == "not run" and "rerun the analysis" in p.reason for p in parts), [p.reason for p in parts]
+    none = change.assign(change_hz=np.nan, reason="no agent-episode has 3 or more 'ate' events")
+    parts = cl.CLAIMS["C6"].assess({**tables, A("signalling", "wide2", "peri_event_episodes"): none}, CFG)[1]
+    assert all(p.reason == "no agent-episode has 3 or more 'ate' events" for p in parts)
 
 
 def test_no_planted_effect_at_large_n_is_weaker_not_holds_nor_fails():

@@ -11,9 +11,7 @@ import numpy as np
 import pandas as pd
 from scipy import stats as sps
 
-from ..analysis._tables import AGENT_EPISODE, eod_rate, value_of
-from ..analysis.signalling import EVENTS, peri_event_rate, power_law_vs_exponential_clustered
-from ..config.recorded import step_rates
+from ..analysis.signalling import EVENTS, power_law_vs_exponential_clustered
 from ..layout import analysis_table, assay_table
 from .context import Context, claim
 from .parts import one_sample_part, per_episode, slope_of, spearman_part, stat_row
@@ -48,7 +46,9 @@ def c4(ctx: Context) -> list[Part]:
                      "across episodes", compute)]
 
 
-WIDE2_STEPS, WIDE2_CONDITIONS = assay_table("wide2", "steps"), assay_table("wide2", "conditions")
+WIDE2_STEPS = assay_table("wide2", "steps")  # the claims of Fig 6 read it
+RATE_BY_DISTANCE = analysis_table("signalling", "wide2", "rate_by_distance_episodes")
+PERI_EVENT = analysis_table("signalling", "wide2", "peri_event_episodes")
 
 
 def _friedman_w(rates: np.ndarray) -> tuple[float, float, int, int]:
@@ -67,27 +67,25 @@ def _friedman_w(rates: np.ndarray) -> tuple[float, float, int, int]:
     return float(chi2 / (n * (k - 1))), float(p), n, k
 
 
-@claim("C5", "3E-G", "the EOD rate varies with distance to agent, food and wall", [WIDE2_STEPS, WIDE2_CONDITIONS])
-def c5(ctx: Context) -> list[Part]:
-    a = ctx.cfg.analysis
+def _rows(ctx: Context, path: str, column: str, value: str, rate: str) -> pd.DataFrame:
+    """The rows of the analysis table ``path`` whose ``column`` is ``value`` and whose ``rate`` is finite; a
+    ValueError with the table's reasons when there are none."""
+    table = ctx.table(path)
+    rows = table[table[column] == value]
+    if not rows[rate].notna().any():
+        reasons = [r for r in dict.fromkeys(rows["reason"].dropna()) if r]
+        raise ValueError("; ".join(reasons) or f"no {column} {value!r} in {path}")
+    return rows.dropna(subset=[rate])
 
+
+@claim("C5", "3E-G", "the EOD rate varies with distance to agent, food and wall", [RATE_BY_DISTANCE])
+def c5(ctx: Context) -> list[Part]:
     def compute(to: str) -> Outcome:
-        steps, fps = ctx.table(WIDE2_STEPS), step_rates(ctx.recorded("wide2"))  # Hz at each condition's rate
-        dist = steps[f"dist_{to}_cm"].to_numpy(np.float64)
-        edges = np.linspace(0.0, getattr(a, f"{to}_range_cm"), a.rate_bins + 1)
-        frame = steps[AGENT_EPISODE].assign(rate=eod_rate(steps, a.rate_window, fps=fps),
-                                            bin=np.clip(np.searchsorted(edges, dist, side="right") - 1, 0,
-                                                        a.rate_bins - 1))
-        frame = frame[np.isfinite(frame["rate"]) & (dist >= edges[0]) & (dist <= edges[-1])]
-        # each agent-episode's mean rate per bin (bins with enough steps), then the episode's agents averaged:
-        # steps of one episode are not independent, nor are its agents
-        per = frame.groupby([*AGENT_EPISODE, "bin"])["rate"].agg(["mean", "size"])
-        per = per[per["size"] >= a.min_samples]["mean"].rename("rate").reset_index()
-        per = per.groupby(["condition", "episode", "bin"], as_index=False)["rate"].mean()
-        if per.empty:
-            raise ValueError(f"no agent-episode has {a.min_samples} steps in a {to} distance bin")
-        # one row per episode, one column per bin: a bootstrap resample then only picks rows
-        wide = per.pivot_table(index=["condition", "episode"], columns="bin", values="rate").reset_index()
+        # the signalling analysis's per-episode rates: each agent-episode's mean rate per distance bin (bins with
+        # enough steps), averaged over the episode's agents; one row per episode, one column per bin, so that a
+        # bootstrap resample only picks rows
+        per = _rows(ctx, RATE_BY_DISTANCE, "to", to, "rate_hz")
+        wide = per.pivot_table(index=["condition", "episode"], columns="bin", values="rate_hz").reset_index()
         bins = [c for c in wide.columns if c not in ("condition", "episode")]
         w, p, n, k = _friedman_w(wide[bins].to_numpy(np.float64))
         reason = (f"{k} distance bins over {n} episodes that reach them all" if np.isfinite(p) else
@@ -100,35 +98,20 @@ def c5(ctx: Context) -> list[Part]:
 
 
 @claim("C6", "3H-J", "the EOD rate rises around eating, builds before biting, rises around being bitten",
-       [WIDE2_STEPS, WIDE2_CONDITIONS])
+       [PERI_EVENT])
 def c6(ctx: Context) -> list[Part]:
     a = ctx.cfg.analysis
     (e0, e1), (b0, b1) = a.claims_event_window, a.claims_baseline_window
 
     def compute(event: str) -> Outcome:
-        if max(abs(e0), abs(e1), abs(b0), abs(b1)) > a.peri_window:
-            raise ValueError(f"the windows reach beyond analysis.peri_window = {a.peri_window} steps")
-        steps, fps = ctx.table(WIDE2_STEPS), step_rates(ctx.recorded("wide2"))
-        if steps.empty:
-            raise ValueError("the wide2 steps table is empty")
-        # one peri-event curve per agent-episode: peri_event_rate averages within a condition, so each
-        # agent-episode becomes its own condition here, in Hz at its real condition's recorded rate
-        unit = steps["condition"].astype(str) + "|" + steps["episode"].astype(str) + "|" + steps["agent"].astype(str)
-        curves = pd.concat([peri_event_rate(sub.assign(condition=unit[sub.index]), event, a.peri_window, a.min_events,
-                                            a.rate_window, fps=value_of(fps, cond))
-                            for cond, sub in steps.groupby("condition", sort=True)], ignore_index=True)
-        curves = curves[curves["n_agents"] > 0]
-        if curves.empty:
-            raise ValueError(f"no agent-episode has {a.min_events} or more '{event}' events")
-        lag = curves["lag"]
-        near = curves[(lag >= e0) & (lag <= e1)].groupby("condition")["mean_hz"].mean()
-        base = curves[(lag >= b0) & (lag <= b1)].groupby("condition")["mean_hz"].mean()
-        diff = (near - base).dropna().rename("diff").reset_index()
-        # back to the real condition and episode
-        parts = diff["condition"].str.rsplit("|", n=2)
-        diff["condition"], diff["episode"] = parts.str[0], parts.str[1]
-        # the agents of one episode are one unit: their mean change, tested across episodes
-        return one_sample_part(ctx, per_episode(diff, "diff"), "diff", 0.0, +1)
+        # the signalling analysis's per-episode change: the agents' mean rate at the event window's lags minus the
+        # baseline window's, averaged over the episode's agents (the agents of one episode are one unit)
+        rows = _rows(ctx, PERI_EVENT, "event", event, "change_hz")
+        ran = rows[["event_lo", "event_hi", "baseline_lo", "baseline_hi"]].drop_duplicates().to_numpy().tolist()
+        if ran != [[e0, e1, b0, b1]]:
+            raise ValueError(f"the signalling analysis ran with windows {ran} (event lo, hi, baseline lo, hi), the "
+                             f"claims with [{e0}, {e1}] and [{b0}, {b1}]: rerun the analysis")
+        return one_sample_part(ctx, per_episode(rows, "change_hz"), "change_hz", 0.0, +1)
     stat = (f"Hodges-Lehmann estimate over episodes of the agents' mean EOD rate at lags [{e0}, {e1}] minus "
             f"[{b0}, {b1}] steps of the event (wide2); Wilcoxon vs 0")
     return [ctx.part(event, stat, functools.partial(compute, event)) for event in EVENTS]
