@@ -490,9 +490,10 @@ class AnalysisConfig:
     claims_ceiling_share: float = param(0.5, "claims: a condition that ate every pellet in at least this share of "
                                         "its episodes is at a ceiling: its food parts are not decidable", lo=0.0,
                                         hi=1.0)
-    claims_event_window: list = param([-10, 10], "claims C6: lags (steps) of the EOD rate around an event")
-    claims_baseline_window: list = param([-100, -50], "claims C6: lags (steps) of the baseline rate; within "
-                                         "+-peri_window")
+    claims_event_window: list = param([-10, 10], "signalling peri_event_episodes (claim C6): lags (steps) of the "
+                                      "EOD rate around an event")
+    claims_baseline_window: list = param([-100, -50], "signalling peri_event_episodes (claim C6): lags (steps) of "
+                                         "the baseline rate; within +-peri_window")
     claims_deff_fraction: float = param(0.5, "claims C17: D_eff / network width is below this when low-dimensional",
                                         lo=0.0, hi=1.0)
     claims_near_cm: float = param(10.0, "claims C21: a conspecific this close is near, cm", lo=0.0)
