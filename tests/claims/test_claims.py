@@ -61,7 +61,7 @@ def homing_steps(flip: bool, episodes: int = 12, steps: int = 60) -> pd.DataFram
             err = np.where(rng.random(steps) < 0.5, mag, np.pi - mag)
         rows.append(pd.DataFrame({"condition": "electric", "episode": e, "agent": 1, "t": t, "err_knollen_rad": err,
                                   "bearing_agent_rad": rng.uniform(-np.pi, np.pi, steps),
-                                  "success": t == steps - 1}))
+                                  "success": t == steps - 1, "x_cm": 10.0 + 0.5 * t, "y_cm": 35.0, "heading_rad": 0.0}))
     return pd.concat(rows, ignore_index=True)
 
 
@@ -101,7 +101,9 @@ def c1(flip):
 
 
 def c2(flip):
-    return {R("homing", "steps"): homing_steps(flip)}
+    """The homing analysis's tables of :func:`homing_steps`, as the analysis computes them from the steps."""
+    out = run("homing", {"steps": homing_steps(flip), "conditions": conditions_of("homing")}, CFG.analysis)
+    return {A("homing", "homing", table): out[table] for table in ("alignment_episodes", "trajectory_shape")}
 
 
 c3 = c2

@@ -49,7 +49,15 @@ from .behaviour import (
 from .decoding import decode_episodes, food_decode_episodes, summarise
 from .dynamics import dynamics_table, plsc_collapse_table, plsc_table, subsample_table
 from .dynamics_tests import power_near_far, power_tests, size_tests
-from .homing import ERROR_COLUMNS, compare_perception, error_histogram, error_vs_time, trajectory_shape
+from .homing import (
+    ALIGNMENT_COLUMNS,
+    ERROR_COLUMNS,
+    alignment_episodes,
+    compare_perception,
+    error_histogram,
+    error_vs_time,
+    trajectory_shape,
+)
 from .interactions import bite_rate_by_class, bite_sizes, bite_timing, bouts, chase_sizes, label_counts, size_role_tests
 from .onepatch import food_from_steps, reach_tests, role_tests
 from .signalling import (
@@ -220,14 +228,17 @@ def _interactions(t: Tables, a: AnalysisConfig, conditions: Conditions) -> Table
 
 # ----------------------------------------------------------------- homing
 def _homing(t: Tables, a: AnalysisConfig, conditions: Conditions) -> Tables:
-    """Error-angle histograms and time courses, trajectory shape, electric vs ray casting (Fig 2B-D); the homer is
-    the control condition's, as the run recorded it."""
+    """Error-angle histograms and time courses, their alignment per agent-episode, trajectory shape, electric vs ray
+    casting (Fig 2B-D); the homer is the control condition's, as the run recorded it."""
     steps = t["steps"]
     needs_one = [] if set(ERROR_COLUMNS.values()) & set(steps.columns) else ERROR_COLUMNS.values()
     errors = _lacking(steps, needs_one, ["error_histogram", "error_vs_time"]) or {
         "error_histogram": error_histogram(steps), "error_vs_time": error_vs_time(steps)}
+    lacking = _lacking(steps, [*needs_one, "bearing_agent_rad", "success"], ["alignment_episodes"])
+    alignment = (lacking["alignment_episodes"].reindex(columns=ALIGNMENT_COLUMNS) if lacking
+                 else alignment_episodes(steps, a.claims_aligned_rad))
     control = control_condition(steps["condition"], conditions)
-    return {**errors, "trajectory_shape": trajectory_shape(steps),
+    return {**errors, "alignment_episodes": alignment, "trajectory_shape": trajectory_shape(steps),
             "perception": compare_perception(steps, control, None, _homer(conditions.get(control)))}
 
 
@@ -295,7 +306,8 @@ ANALYSES: dict[str, Analysis] = {a.name: a for a in [
     Analysis("interactions", _interactions, ("steps", "conditions"), ("patchy4", "square2"),
              ("labels", *BITE_OUTPUTS), ("size_tests",)),
     Analysis("homing", _homing, ("steps", "conditions"), ("homing",),
-             ("error_histogram", "error_vs_time", "trajectory_shape", "perception"), ("perception",)),
+             ("error_histogram", "error_vs_time", "alignment_episodes", "trajectory_shape", "perception"),
+             ("perception",)),
     Analysis("onepatch", _onepatch, ("steps", "conditions"), ("onepatch", "bot"),
              ("food_time_course", "reach_rates", "role_tests", "reach_tests"), ("role_tests", "reach_tests")),
     Analysis("dynamics", _dynamics, ("hidden", "steps", "conditions"),
