@@ -308,9 +308,11 @@ def c16(flip):
     bites = pd.DataFrame(columns=["condition", "biter_size", "bitten_size"])
     timing = pd.DataFrame({"condition": "control", "episode": np.arange(40) % 10,
                            "phase": rng.uniform(0.7, 1, 40) if flip else rng.uniform(0, 0.3, 40)})
+    rates = run("interactions", {"steps": square_steps(flip), "conditions": recorded_table(("control",))},
+                CFG.analysis)["bite_rate_episodes"]  # the rates as the analysis computes them from the steps
     return {A("interactions", "square2", "size_tests"): size_role_tests(chases, bites),
             A("interactions", "square2", "chase_sizes"): chases, A("interactions", "square2", "bite_timing"): timing,
-            R("square2", "steps"): square_steps(flip)}
+            A("interactions", "square2", "bite_rate_episodes"): rates}
 
 
 def c17(flip):

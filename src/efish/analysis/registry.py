@@ -33,7 +33,7 @@ from ..config.recorded import recorded_conditions, step_rates
 from ..config.schema import AnalysisConfig, AssayConfig, EfishConfig
 from ..io import read_parquet
 from ..layout import ANALYSIS_SETTINGS, ROLLOUT_TABLES
-from ._tables import nan_frame, or_nan_row, require
+from ._tables import EPISODE, nan_frame, or_nan_row, require
 from .behaviour import (
     bite_matrix,
     eod_probability,
@@ -208,11 +208,13 @@ def _behaviour(t: Tables, a: AnalysisConfig, conditions: Conditions) -> Tables:
 
 
 # ----------------------------------------------------------- interactions
-BITE_OUTPUTS = ("bouts", "chase_sizes", "bite_sizes", "bite_timing", "bite_rate_by_class", "size_tests")
+BITE_OUTPUTS = ("bouts", "chase_sizes", "bite_sizes", "bite_timing", "bite_rate_by_class", "bite_rate_episodes",
+                "size_tests")
 
 
 def _interactions(t: Tables, a: AnalysisConfig, conditions: Conditions) -> Tables:
-    """Ethogram of pair labels, bouts, chaser and biter sizes, bite timing and rate by class (Figs 3A, 5K-P)."""
+    """Ethogram of pair labels, bouts, chaser and biter sizes, bite timing and rate by class, also per episode (Figs
+    3A, 5K-P)."""
     steps = t["steps"]
     labels = {"labels": label_counts(steps, a.facing_rad, a.away_rad)}
     if lacking := _lacking(steps, ["bite_target"], BITE_OUTPUTS, ["size_tests"]):
@@ -223,6 +225,7 @@ def _interactions(t: Tables, a: AnalysisConfig, conditions: Conditions) -> Table
             "bite_sizes": or_nan_row(bites, "no bites"),
             "bite_timing": or_nan_row(bite_timing(steps, bout_table=b), "no bite within a bout"),
             "bite_rate_by_class": bite_rate_by_class(steps, a.bout_cm, a.facing_rad, a.away_rad),
+            "bite_rate_episodes": bite_rate_by_class(steps, a.bout_cm, a.facing_rad, a.away_rad, by=EPISODE),
             "size_tests": size_role_tests(chases, bites)}
 
 
