@@ -47,8 +47,8 @@ from .behaviour import (
     win_ratios,
 )
 from .decoding import decode_episodes, food_decode_episodes, summarise
-from .dynamics import dynamics_table, plsc_collapse_table, plsc_table, subsample_table
-from .dynamics_tests import power_near_far, power_tests, size_tests
+from .dynamics import dynamics_table, plsc_collapse_table, plsc_episodes, plsc_table, subsample_table
+from .dynamics_tests import power_near_far, power_roles, power_tests, size_tests
 from .homing import (
     ALIGNMENT_COLUMNS,
     ERROR_COLUMNS,
@@ -261,9 +261,10 @@ def _onepatch(t: Tables, a: AnalysisConfig, conditions: Conditions) -> Tables:
 # --------------------------------------------------------------- dynamics
 def _dynamics(t: Tables, a: AnalysisConfig, conditions: Conditions) -> Tables:
     """Hidden-state dimensionality, power, unit subsampling, decoding per episode and its mean over episodes (also of
-    food near and far; homing: the homer's states), PLSC of agents 0 and 1 with the test of fewer shared dimensions
-    far than near, and the tests of D_eff against group size and of wideband power by context (Fig 6), each
-    condition's power per Hz of its recorded steps per second."""
+    food near and far; homing: the homer's states), PLSC of agents 0 and 1 (also its first component per episode
+    and distance bin) with the test of fewer shared dimensions far than near, wideband power by context and by
+    size, and the tests of D_eff against group size and of wideband power (Fig 6), each condition's power per Hz of
+    its recorded steps per second."""
     hidden, steps, fps = t["hidden"], t["steps"], step_rates(conditions)
     rng = np.random.default_rng(a.seed)
     dims = dynamics_table(hidden, a.variance_fraction, a.spectrogram_window, a.spectrogram_overlap, fps=fps)
@@ -277,6 +278,7 @@ def _dynamics(t: Tables, a: AnalysisConfig, conditions: Conditions) -> Tables:
             "food_decoding": summarise(food, by=("food",)), "food_decoding_episodes": food,
             "plsc": plsc_table(hidden, steps, (0, 1), a.plsc_edges_cm, a.plsc_shifts, rng, a.plsc_percentile,
                                a.plsc_null_draws, a.claims_alpha),
+            "plsc_episodes": plsc_episodes(hidden, steps, (0, 1), a.plsc_edges_cm),
             "plsc_collapse": plsc_collapse_table(hidden, steps, (0, 1), a.plsc_edges_cm, a.plsc_null_draws,
                                                  a.claims_alpha, swaps=a.plsc_label_swaps, rng=rng),
             "condition_tests": dunnett_by_measure(dims, DYNAMICS_MEASURES, "condition", control, a.seed),
@@ -285,14 +287,15 @@ def _dynamics(t: Tables, a: AnalysisConfig, conditions: Conditions) -> Tables:
 
 def _power(hidden: pd.DataFrame, steps: pd.DataFrame, dims: pd.DataFrame, a: AnalysisConfig,
            fps: Mapping[str, float]) -> Tables:
-    """Wideband power near vs far from the nearest conspecific, and its tests (Fig 6I,J); NaN rows without the
-    steps columns it needs."""
-    if lacking := _lacking(steps, ["dist_agent_cm", "size"], ["power_near_far", "power_tests"], ["power_tests"]):
+    """Wideband power near vs far from the nearest conspecific, of the smaller and the larger agents, and their tests
+    (Fig 6I,J); NaN rows without the steps columns it needs."""
+    if lacking := _lacking(steps, ["dist_agent_cm", "size"], ["power_near_far", "power_roles", "power_tests"],
+                           ["power_tests"]):
         return lacking
     near_far = power_near_far(hidden, steps, a.claims_near_cm, a.claims_far_cm, a.spectrogram_window,
                               a.spectrogram_overlap, fps)
     return {"power_near_far": or_nan_row(near_far, "no agent-episode with a hidden state"),
-            "power_tests": power_tests(near_far, dims, steps)}
+            "power_roles": power_roles(dims, steps), "power_tests": power_tests(near_far, dims, steps)}
 
 
 #: The assays whose food, bites, spacing and EOD probability the behaviour analysis summarises (Figs 3-5).
@@ -316,8 +319,8 @@ ANALYSES: dict[str, Analysis] = {a.name: a for a in [
     Analysis("dynamics", _dynamics, ("hidden", "steps", "conditions"),
              ("patchy4", "wide2", "homing", "groupsize", "square2"),
              ("dimensionality", "subsampling", "decoding", "decoding_episodes", "food_decoding",
-              "food_decoding_episodes", "plsc", "plsc_collapse", "condition_tests", "size_tests", "power_near_far",
-              "power_tests"), ("condition_tests", "size_tests", "power_tests")),
+              "food_decoding_episodes", "plsc", "plsc_episodes", "plsc_collapse", "condition_tests", "size_tests",
+              "power_near_far", "power_roles", "power_tests"), ("condition_tests", "size_tests", "power_tests")),
 ]}
 
 
