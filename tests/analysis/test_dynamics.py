@@ -18,6 +18,7 @@ from efish.analysis.dynamics import (
     pcs_for_variance,
     plsc,
     plsc_by_distance,
+    plsc_episodes,
     subsample_units,
     wideband_power,
 )
@@ -135,3 +136,35 @@ def test_plsc_by_distance_finds_sharing_only_where_planted():
     assert out["hi_cm"].tolist() == [10.0, 100.0, np.inf] and (out["reason"] == "").all()
     sparse = plsc_by_distance(h_a[:20], h_b[:20], np.full(20, 500.0), rng=0)
     assert sparse.loc[0, "reason"].startswith("need a T x D") and np.isnan(sparse.loc[0, "n_significant"])
+
+
+def test_plsc_episodes_gives_each_episodes_first_component_per_distance_bin():
+    """Two episodes, each 30 steps 5 cm apart, 30 at 50 cm, 5 at 500 cm: the agents share their states only when
+    close, so r_1 is 1 in the first bin; the third bin has too few steps. Agent 2 is left out."""
+    rng = np.random.default_rng(0)
+    dist = np.r_[np.full(30, 5.0), np.full(30, 50.0), np.full(5, 500.0)]
+    t, units = np.arange(len(dist)), [f"h_{i}" for i in range(4)]
+    hidden, steps = [], []
+    for episode in (0, 1):
+        own = rng.normal(size=(len(t), 4))
+        for agent in (0, 1, 2):
+            h = np.where((dist == 5.0)[:, None] | (agent == 0), own, rng.normal(size=(len(t), 4)))
+            hidden.append(pd.DataFrame(h, columns=units).assign(condition="c", episode=episode, agent=agent, t=t))
+            steps.append(pd.DataFrame({"condition": "c", "episode": episode, "agent": agent, "t": t,
+                                       "x_cm": dist * (agent == 1), "y_cm": 0.0}))
+    hidden, steps = pd.concat(hidden, ignore_index=True), pd.concat(steps, ignore_index=True)
+    out = plsc_episodes(hidden.sample(frac=1.0, random_state=0), steps)
+    assert out[["episode", "bin", "n_steps"]].to_numpy().tolist() == [[e, b, n] for e in (0, 1)
+                                                                      for b, n in enumerate((30, 30, 5))]
+    assert (out["agent_a"] == 0).all() and (out["agent_b"] == 1).all()
+    assert out["hi_cm"].tolist() == [10.0, 100.0, np.inf] * 2 and out["lo_cm"].tolist() == [0.0, 10.0, 100.0] * 2
+    close, mid, far = (out[out["bin"] == b] for b in range(3))
+    assert close["r_1"].to_numpy() == pytest.approx(1.0) and (mid["r_1"] < close["r_1"].to_numpy()).all()
+    assert far["r_1"].isna().all() and far["reason"].str.startswith("need a T x D").all()
+    # the first component of plsc on the same steps (the paper's procedure, without its null)
+    mine = hidden.sort_values(["agent", "t"], kind="stable").query("episode == 1 and t >= 30 and t < 60")
+    ref = plsc(mine[mine["agent"] == 0][units], mine[mine["agent"] == 1][units], shifts=1, rng=0)
+    assert mid["r_1"].iloc[1] == pytest.approx(ref["correlations"][0], rel=1e-12)
+    assert mid["s_1"].iloc[1] == pytest.approx(ref["singular_values"][0], rel=1e-12)
+    alone = plsc_episodes(hidden, steps, agents=(0, 3))
+    assert len(alone) == 1 and alone.loc[0, "reason"] == "agents 0 and 3 share no step"

@@ -8,7 +8,15 @@ import pandas as pd
 import pytest
 from scipy import stats as sps
 
-from efish.analysis.dynamics_tests import groupsize_parts, power_near_far, power_tests, size_tests
+from efish.analysis.dynamics import dynamics_table
+from efish.analysis.dynamics_tests import (
+    ROLE_COLUMNS,
+    groupsize_parts,
+    power_near_far,
+    power_roles,
+    power_tests,
+    size_tests,
+)
 from efish.analysis.stats import STAT_COLUMNS
 
 
@@ -80,3 +88,24 @@ def test_power_tests_say_why_without_far_steps_or_size_differences():
     assert "near and far" in tests.loc["near_far", "reason"] and "sizes" in tests.loc["size", "reason"]
     with pytest.raises(ValueError, match="far_cm"):
         power_near_far(hidden, steps, 100.0, 10.0, 20, 10, 50.0)
+
+
+def test_power_roles_name_the_smallest_agent_of_each_episode_and_carry_its_power():
+    """In :func:`pair` agent 0 (size 0.3) is the smaller and twice as loud: its power is about 4 times the larger's
+    in every episode; a third agent the size of agent 1 is larger too; an episode of one size is left out."""
+    hidden, steps = pair()
+    third = hidden[hidden["agent"] == 1].assign(agent=2)
+    hidden = pd.concat([hidden, third], ignore_index=True)
+    steps = pd.concat([steps, steps[steps["agent"] == 1].assign(agent=2)], ignore_index=True)
+    steps.loc[steps["episode"] == 7, "size"] = 0.5  # one size: no smaller agent
+    dims = dynamics_table(hidden, fps=50.0)
+    roles = power_roles(dims, steps)
+    assert list(roles.columns) == ROLE_COLUMNS and sorted(roles["episode"].unique()) == list(range(7))
+    assert roles.groupby("role")["agent"].unique().map(sorted).to_dict() == {"larger": [1, 2], "smaller": [0]}
+    assert roles.set_index(["episode", "agent"])["size"].loc[(0, 0)] == pytest.approx(0.3)
+    wide = roles.pivot_table(index="episode", columns="role", values="wideband_power")
+    assert (wide["smaller"] / wide["larger"]).between(2, 8).all()
+    np.testing.assert_array_equal(roles["wideband_power"], dims.set_index(["episode", "agent"]).loc[
+        pd.MultiIndex.from_frame(roles[["episode", "agent"]]), "wideband_power"])
+    alike = power_roles(dims, steps.assign(size=0.5))
+    assert len(alike) == 1 and alike.loc[0, "reason"] == "no episode with agents of different sizes"

@@ -7,6 +7,8 @@ import pandas as pd
 import pytest
 
 from efish.analysis.homing import (
+    ALIGNMENT_COLUMNS,
+    alignment_episodes,
     compare_perception,
     error_angles,
     error_histogram,
@@ -32,6 +34,32 @@ def test_error_angles_long_table_and_normalised_time():
     assert set(long["channel"]) == {"morm", "knollen"}
     with pytest.raises(ValueError, match="error-angle column"):
         error_angles(path([0.0], [0.0]))
+
+
+def test_alignment_per_agent_episode_against_a_straight_homer():
+    """Episode 0: 8 of 10 Knollenorgan errors within pi/4 of 0 or pi, a straight homer (error + bearing) aligned on
+    none, |sin err| falling over time; episode 1: none aligned, a straight homer on every step, |sin err| constant
+    (no rho); episode 2: episode 0's errors with the bearing 0 (a straight homer as aligned as the homer), no
+    success. The frozen target (agent 0) senses nothing: no row."""
+    err = np.r_[1.5, 1.4, np.linspace(0.7, 0.05, 7), np.pi - 0.02]  # 8 within pi/4 of 0 or pi, |sin| falling
+    ep0 = path(np.arange(10.0), np.zeros(10), err_knollen_rad=err, bearing_agent_rad=np.pi / 2 - err,
+               success=np.arange(10) == 9)
+    ep1 = path(np.arange(10.0), np.zeros(10), episode=1, err_knollen_rad=np.pi / 2,
+               bearing_agent_rad=-np.pi / 2, success=np.arange(10) == 9)
+    ep2 = path(np.arange(10.0), np.zeros(10), episode=2, err_knollen_rad=err, bearing_agent_rad=0.0, success=False)
+    target = path(np.zeros(10), np.zeros(10), agent=0, err_knollen_rad=np.nan, bearing_agent_rad=0.0, success=False)
+    out = alignment_episodes(pd.concat([ep0, ep1, ep2, target], ignore_index=True))
+    assert list(out.columns) == ALIGNMENT_COLUMNS
+    assert out[["episode", "agent", "channel"]].to_numpy().tolist() == [[0, 1, "knollen"], [1, 1, "knollen"],
+                                                                       [2, 1, "knollen"]]
+    assert out["success"].tolist() == [True, True, False] and (out["n_steps"] == 10).all()
+    assert out["aligned_fraction"].tolist() == pytest.approx([0.8, 0.0, 0.8])
+    assert out["straight_aligned_fraction"].tolist() == pytest.approx([0.0, 1.0, 0.8])
+    assert out["aligned_excess"].tolist() == pytest.approx([0.8, -1.0, 0.0])
+    assert out.loc[0, "alignment_rho"] == pytest.approx(-1.0) and out.loc[0, "reason"] == ""
+    assert np.isnan(out.loc[1, "alignment_rho"]) and out.loc[1, "reason"] == "abs_sin is constant"
+    wide = alignment_episodes(ep0, aligned_rad=np.pi / 2)  # every step within pi/2 of 0 or pi
+    assert wide.loc[0, "aligned_fraction"] == 1.0
 
 
 def test_error_histogram_density_integrates_to_one():

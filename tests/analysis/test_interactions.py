@@ -117,6 +117,27 @@ def test_bite_rate_by_class():
     assert len(far) == 1 and "within 10.0 cm" in far.loc[0, "reason"]
 
 
+def test_bite_rate_per_episode_is_each_episodes_own_and_pools_to_the_condition():
+    """Episode 0: 4 chasing pair-steps (and their 4 fleeing mirrors), 1 bite; episode 1: 3 confronting steps (6
+    ordered pair-steps, 2 bites) and 5 steps out of range; episode 2: never within range (no rows)."""
+    chase = two_fish(np.full(4, 5.0), 0.0, 0.0, bites0=np.where(np.arange(4) == 1, 1, -1))
+    confront = two_fish(np.r_[np.full(3, 5.0), np.full(5, 50.0)], 0.0, PI, bites0=np.r_[1, -1, 1, np.full(5, -1)])
+    apart = two_fish(np.full(4, 50.0), 0.0, 0.0)
+    steps = pd.concat([chase, confront.assign(episode=1), apart.assign(episode=2)], ignore_index=True)
+    out = bite_rate_by_class(steps, by=("condition", "episode"))
+    assert len(out) == 2 * len(LABELS) and out["episode"].unique().tolist() == [0, 1]
+    rate = out.set_index(["episode", "label"])
+    assert (rate.loc[(0, "chasing"), "n_steps"], rate.loc[(0, "chasing"), "bites"]) == (4, 1)
+    assert rate.loc[(0, "chasing"), "rate"] == 0.25 and np.isnan(rate.loc[(0, "confronting"), "rate"])
+    assert (rate.loc[(1, "confronting"), "n_steps"], rate.loc[(1, "confronting"), "rate"]) == (6, pytest.approx(1 / 3))
+    assert rate.loc[(1, "chasing"), "reason"] == "label never seen within range"
+    pooled = bite_rate_by_class(steps).set_index("label")
+    summed = out.groupby("label")[["n_steps", "bites"]].sum()
+    assert pooled[["n_steps", "bites"]].equals(summed.loc[pooled.index])
+    far = bite_rate_by_class(apart, by=("condition", "episode"))
+    assert len(far) == 1 and np.isnan(far.loc[0, "episode"]) and "within 10.0 cm" in far.loc[0, "reason"]
+
+
 def test_empty_steps_give_empty_bouts_not_errors():
     empty = two_fish(np.empty(0), 0.0, 0.0)
     assert bouts(empty).empty and chase_sizes(empty).empty and bite_timing(empty).empty

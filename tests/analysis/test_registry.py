@@ -133,6 +133,29 @@ def test_settings_and_the_recorded_rate_reach_the_functions(tables, tmp_path):
     np.testing.assert_allclose(out["idis"]["idi_ms"], out["idis"]["idi_steps"] * 10.0)  # 1000 / env.fps
 
 
+def test_the_per_unit_tables_the_claims_read_follow_the_jobs_settings(tables):
+    """The per-episode tables the claims select rows of (issue 38) are the analysis's, under its settings: the aligned
+    band (homing), the bout range (interactions), the PLSC distance edges (dynamics)."""
+    homing = {"steps": tables["steps"].query("agent < 2").replace({"condition": {"control": "electric"}})
+              .query("condition == 'electric'"), "conditions": conditions_of("homing")}
+    narrow, wide = (run("homing", homing, cfg_with("assay=homing", f"analysis.claims_aligned_rad={a}").analysis)
+                    ["alignment_episodes"] for a in (0.1, 1.5))
+    assert len(narrow) and (narrow["aligned_fraction"] < wide["aligned_fraction"]).all()
+    assert narrow["aligned_excess"].equals(narrow["aligned_fraction"] - narrow["straight_aligned_fraction"])
+    within = []
+    for bout_cm in (10.0, 30.0):
+        out = run("interactions", tables, cfg_with(f"analysis.bout_cm={bout_cm}").analysis)
+        pooled = out["bite_rate_episodes"].groupby(["condition", "label"])[["n_steps", "bites"]].sum()
+        by_class = out["bite_rate_by_class"].set_index(["condition", "label"])[["n_steps", "bites"]]
+        assert pooled.loc[by_class.index].equals(by_class)
+        within.append(pooled["n_steps"].sum())
+    assert within[0] < within[1]
+    dynamics = run("dynamics", tables, cfg_with("scale=smoke", "analysis.plsc_edges_cm=[20.0]").analysis)
+    bins = dynamics["plsc_episodes"]
+    assert bins.groupby(["condition", "episode"]).size().eq(2).all() and set(bins["hi_cm"]) == {20.0, np.inf}
+    assert {"role", "size", "wideband_power"} <= set(dynamics["power_roles"].columns)
+
+
 def test_a_planted_eod_rate_comes_out_in_hz_at_each_recorded_frame_rate():
     """Issue 38: one condition of the assay recorded at half the default env.fps. Every agent discharges on every
     5th step, so its rate is fps / 5: 16.6 Hz at 83 steps per second, 8.3 Hz at 41.5. The signalling tables say so

@@ -4,6 +4,7 @@ other way round; missing tables give ``not run`` with a reason; reruns are ident
 
 from __future__ import annotations
 
+import functools
 import re
 import zlib
 
@@ -19,7 +20,8 @@ from efish.analysis.behaviour import (
     theil_per_episode,
 )
 from efish.analysis.decoding import decode_episodes, food_decode_episodes, summarise
-from efish.analysis.dynamics_tests import power_near_far, power_tests, size_tests
+from efish.analysis.dynamics import plsc_episodes
+from efish.analysis.dynamics_tests import size_tests
 from efish.analysis.interactions import size_role_tests
 from efish.analysis.onepatch import reach_tests
 from efish.analysis.registry import run
@@ -61,7 +63,7 @@ def homing_steps(flip: bool, episodes: int = 12, steps: int = 60) -> pd.DataFram
             err = np.where(rng.random(steps) < 0.5, mag, np.pi - mag)
         rows.append(pd.DataFrame({"condition": "electric", "episode": e, "agent": 1, "t": t, "err_knollen_rad": err,
                                   "bearing_agent_rad": rng.uniform(-np.pi, np.pi, steps),
-                                  "success": t == steps - 1}))
+                                  "success": t == steps - 1, "x_cm": 10.0 + 0.5 * t, "y_cm": 35.0, "heading_rad": 0.0}))
     return pd.concat(rows, ignore_index=True)
 
 
@@ -101,7 +103,9 @@ def c1(flip):
 
 
 def c2(flip):
-    return {R("homing", "steps"): homing_steps(flip)}
+    """The homing analysis's tables of :func:`homing_steps`, as the analysis computes them from the steps."""
+    out = run("homing", {"steps": homing_steps(flip), "conditions": conditions_of("homing")}, CFG.analysis)
+    return {A("homing", "homing", table): out[table] for table in ("alignment_episodes", "trajectory_shape")}
 
 
 c3 = c2
@@ -316,9 +320,11 @@ def c16(flip):
     bites = pd.DataFrame(columns=["condition", "biter_size", "bitten_size"])
     timing = pd.DataFrame({"condition": "control", "episode": np.arange(40) % 10,
                            "phase": rng.uniform(0.7, 1, 40) if flip else rng.uniform(0, 0.3, 40)})
+    rates = run("interactions", {"steps": square_steps(flip), "conditions": recorded_table(("control",))},
+                CFG.analysis)["bite_rate_episodes"]  # the rates as the analysis computes them from the steps
     return {A("interactions", "square2", "size_tests"): size_role_tests(chases, bites),
             A("interactions", "square2", "chase_sizes"): chases, A("interactions", "square2", "bite_timing"): timing,
-            R("square2", "steps"): square_steps(flip)}
+            A("interactions", "square2", "bite_rate_episodes"): rates}
 
 
 def c17(flip):
@@ -412,32 +418,41 @@ def c19(flip):
     return decoding_tables("wide2", tables[R("wide2", "hidden")], tables[R("wide2", "steps")])
 
 
+@functools.lru_cache(maxsize=None)
+def wide2_dynamics(flip: bool, louder: float = 1.0) -> dict:
+    """The dynamics analysis's tables of :func:`wide_pair`'s steps and hidden states (agent 0 of size 0.3, agent 1 of
+    0.7), with the hidden states of the smaller agent (``flip``: the larger) ``louder`` times larger. Cached per
+    argument: never edit the tables."""
+    tables = wide_pair(flip)
+    steps, hidden = tables[R("wide2", "steps")], tables[R("wide2", "hidden")]
+    steps = steps.assign(size=np.where(steps["agent"] == 0, 0.3, 0.7))
+    if louder != 1:
+        scale = np.where(hidden["agent"] == (1 if flip else 0), louder, 1.0)
+        hidden = hidden.assign(**{c: hidden[c] * scale for c in hidden if c.startswith("h_")})
+    return run("dynamics", {"hidden": hidden, "steps": steps, "conditions": tables[R("wide2", "conditions")]},
+               CFG.analysis)
+
+
 def c20(flip):
     # the dynamics analysis's collapse row (its test is efish.analysis.plsc_tests's, tested there): 3 shared
-    # dimensions near and none far, or the reverse, over 8 episodes (exact permutation p 2/256)
+    # dimensions near and none far, or the reverse, over 8 episodes (exact permutation p 2/256); the first PLSC
+    # component per episode and bin as the analysis computes it from wide_pair's states
     near, far = (0.0, 3.0) if flip else (3.0, 0.0)
     collapse = pd.DataFrame([{"condition": "control", "agent_a": 0, "agent_b": 1, "near_hi_cm": 10.0,
                               "far_lo_cm": 100.0, "n_episodes": 8, "n_steps": 700, "near_significant": near,
                               "far_significant": far, "count_difference": far - near, "effect": far - near,
                               "p": 2 / 256, "p_less": 1 / 256 if not flip else 1.0, "n_assignments": 256,
                               "exact": True, "reason": ""}])
-    return {**wide_pair(flip), A("dynamics", "wide2", "plsc_collapse"): collapse}
+    return {A("dynamics", "wide2", "plsc_episodes"): wide2_dynamics(flip)["plsc_episodes"],
+            A("dynamics", "wide2", "plsc_collapse"): collapse}
 
 
 def c21(flip):
-    tables = wide_pair(flip)
-    rng = np.random.default_rng(21)
-    episodes = pd.DataFrame({"condition": "control", "episode": np.repeat(np.arange(10), 2),
-                             "agent": np.tile([0, 1], 10), "size": np.tile([0.3, 0.7], 10)})
-    power = np.where(episodes["agent"] == (1 if flip else 0), 2.0, 1.0) + rng.normal(0, 0.1, 20)
-    dims = episodes.drop(columns="size").assign(wideband_power=power)
-    steps = tables[R("wide2", "steps")].merge(episodes, on=["condition", "episode", "agent"])
-    a = CFG.analysis
-    near_far = power_near_far(tables[R("wide2", "hidden")], steps, a.claims_near_cm, a.claims_far_cm,
-                              a.spectrogram_window, a.spectrogram_overlap, CFG.env.fps)
-    return {R("wide2", "steps"): steps, A("dynamics", "wide2", "dimensionality"): dims,
-            A("dynamics", "wide2", "power_near_far"): near_far,
-            A("dynamics", "wide2", "power_tests"): power_tests(near_far, dims, steps)}
+    """The dynamics analysis's power tables of wide_pair, whose far steps are louder (``flip``: quieter) than the
+    near ones, and whose smaller agent's states are 1.5 times larger (``flip``: the larger agent's)."""
+    out = wide2_dynamics(flip, 1.5)
+    return {A("dynamics", "wide2", t): out[t] for t in ("dimensionality", "power_near_far", "power_roles",
+                                                        "power_tests")}
 
 
 #: Per registered claim, the builder of its planted tables above (``c7`` for C7).
@@ -659,6 +674,23 @@ def test_decoding_claims_read_the_analysis_tables_and_say_what_they_lack():
     assert row["verdict"] == "not run" and "lacks column 'err_knollen_rad'" in row["reason"], row["reason"]
     assert set(cl.CLAIMS["C18"].tables) == {A("dynamics", "homing", "decoding_episodes")}
     assert all(t.startswith("analysis/dynamics/wide2/") for t in cl.CLAIMS["C19"].tables)
+
+
+def test_claims_on_per_unit_tables_read_only_analysis_tables_and_say_what_the_analysis_lacked():
+    """C2, C3, C16, C20 and C21 select rows of the homing, interactions and dynamics analyses' per-unit tables (issue
+    38), never a rollout table; where the analysis had no unit, the part is not run with the analysis's reason."""
+    for cid in ("C2", "C3", "C16", "C20", "C21"):
+        assert all(t.startswith("analysis/") for t in cl.CLAIMS[cid].tables), cid
+    steps = homing_steps(False).drop(columns="bearing_agent_rad")
+    out = run("homing", {"steps": steps, "conditions": conditions_of("homing")}, CFG.analysis)
+    row = cl.CLAIMS["C2"].run({A("homing", "homing", "alignment_episodes"): out["alignment_episodes"]}, CFG)
+    assert row["verdict"] == "not run" and "lacks columns ['bearing_agent_rad']" in row["reason"], row["reason"]
+    apart = wide_pair(False)
+    hidden = apart[R("wide2", "hidden")]
+    none_shared = plsc_episodes(hidden[hidden["agent"] == 0], apart[R("wide2", "steps")])
+    row, parts = cl.CLAIMS["C20"].assess({**c20(False), A("dynamics", "wide2", "plsc_episodes"): none_shared}, CFG)
+    assert (parts[0].verdict, parts[0].reason) == ("not run", "agents 0 and 1 share no step")
+    assert row["verdict"] == "weaker"  # the collapse part still holds
 
 
 def test_decoding_parts_without_a_planted_effect_reject_at_about_the_nominal_rate():

@@ -148,6 +148,18 @@ def _plsc_spectrum(za: np.ndarray, zb: np.ndarray, k: int) -> tuple[np.ndarray, 
     return s[:k], r
 
 
+def _standardised(h_a: np.ndarray, h_b: np.ndarray) -> tuple[np.ndarray, np.ndarray, str]:
+    """Two agents' T x D hidden states z-scored per unit (:func:`_zscore`) and ''; when either has fewer than 10 steps
+    or is degenerate (:func:`degenerate_reason`), the states as given and why."""
+    h_a, h_b = np.asarray(h_a, dtype=np.float64), np.asarray(h_b, dtype=np.float64)
+    if len(h_a) != len(h_b):
+        raise ValueError(f"h_a and h_b differ in length: {len(h_a)} vs {len(h_b)}")
+    # at least 10 steps, so that the null's shifts (T/10 to 9T/10) are never 0
+    if reason := degenerate_reason(h_a, 10) or degenerate_reason(h_b, 10):
+        return h_a, h_b, reason
+    return _zscore(h_a), _zscore(h_b), ""
+
+
 def plsc(h_a: np.ndarray, h_b: np.ndarray, shifts: int = DEFAULTS.plsc_shifts,
          rng: np.random.Generator | int | None = None, percentile: float = DEFAULTS.plsc_percentile) -> dict:
     """Partial least squares correlation of two agents' hidden states with a circular-shift null
@@ -161,17 +173,12 @@ def plsc(h_a: np.ndarray, h_b: np.ndarray, shifts: int = DEFAULTS.plsc_shifts,
     and its score correlation both exceed the ``percentile`` of the i-th null
     values; ``n_significant`` counts significant components up to the first that is not.
     """
-    h_a, h_b = np.asarray(h_a, dtype=np.float64), np.asarray(h_b, dtype=np.float64)
-    if len(h_a) != len(h_b):
-        raise ValueError(f"h_a and h_b differ in length: {len(h_a)} vs {len(h_b)}")
-    k = min(h_a.shape[-1], h_b.shape[-1])
-    # at least 10 steps, so that the null's shifts (T/10 to 9T/10) are never 0
-    reason = degenerate_reason(h_a, 10) or degenerate_reason(h_b, 10)
+    za, zb, reason = _standardised(h_a, h_b)
+    k = min(za.shape[-1], zb.shape[-1])
     if reason:
         nan = np.full(k, np.nan)
         return {"singular_values": nan, "correlations": nan, "null_singular_values": nan,
                 "null_correlations": nan, "n_significant": np.nan, "reason": reason}
-    za, zb = _zscore(h_a), _zscore(h_b)
     s, r = _plsc_spectrum(za, zb, k)
     rng = np.random.default_rng(rng)
     t = len(za)
@@ -290,6 +297,42 @@ def plsc_table(hidden: pd.DataFrame, steps: pd.DataFrame, agents: tuple[int, int
                               draws, alpha).assign(condition=c)
              for c in sorted(set(condition))]
     return pd.concat(parts, ignore_index=True).assign(agent_a=agents[0], agent_b=agents[1])
+
+
+#: Columns of :func:`plsc_episodes` (docs/methods/analyses.md#analysis-dynamics).
+PLSC_EPISODE_COLUMNS = ["condition", "episode", "agent_a", "agent_b", "bin", "lo_cm", "hi_cm", "n_steps", "s_1", "r_1",
+                        "reason"]
+
+
+def plsc_episodes(hidden: pd.DataFrame, steps: pd.DataFrame, agents: tuple[int, int] = (0, 1),
+                  edges_cm=tuple(DEFAULTS.plsc_edges_cm)) -> pd.DataFrame:
+    """The first PLSC component of two agents' hidden states per episode and distance bin (Fig 6G; claim C20): one
+    row per episode and bin (columns :data:`PLSC_EPISODE_COLUMNS`).
+
+    The steps of the episode at which both ``agents`` have a hidden state, with their distance in the bin (bins as
+    :func:`plsc_by_distance`'s: ``bin`` 0 the nearest, (``lo_cm``, ``hi_cm``]), in time order: the first singular
+    value ``s_1`` of the cross-covariance of their z-scored states and ``r_1``, the correlation of the paired
+    component scores (:func:`plsc` without its null); NaN with a reason under 10 steps or when degenerate. Without
+    a shared step, one NaN row that says so.
+    """
+    pair = _pair_states(hidden, steps, agents)
+    if pair is None:
+        return nan_frame(f"agents {agents[0]} and {agents[1]} share no step").reindex(columns=PLSC_EPISODE_COLUMNS)
+    a, b, dist = pair
+    h = units(hidden)
+    h_a, h_b = a[h].to_numpy(), b[h].to_numpy()
+    bounds = list(itertools.pairwise([-np.inf, *edges_cm, np.inf]))
+    rows = []
+    for (condition, episode), idx in a.groupby(level=EPISODE, sort=True).indices.items():
+        d = dist[idx]
+        for k, (lo, hi) in enumerate(bounds):
+            keep = idx[(d > lo) & (d <= hi)]
+            za, zb, reason = _standardised(h_a[keep], h_b[keep])
+            s, r = (np.full(1, np.nan),) * 2 if reason else _plsc_spectrum(za, zb, min(za.shape[1], zb.shape[1]))
+            rows.append({"condition": condition, "episode": episode, "agent_a": agents[0], "agent_b": agents[1],
+                         "bin": k, "lo_cm": max(lo, 0.0), "hi_cm": hi, "n_steps": len(keep), "s_1": s[0],
+                         "r_1": r[0], "reason": reason})
+    return pd.DataFrame(rows, columns=PLSC_EPISODE_COLUMNS)
 
 
 #: Columns of :func:`plsc_collapse_table` (docs/methods/analyses.md#analysis-dynamics).

@@ -18,7 +18,7 @@ import re
 import numpy as np
 import pandas as pd
 
-from ._tables import AGENT_EPISODE, EPISODE, PerCondition, agent_sizes, require, value_of
+from ._tables import AGENT_EPISODE, EPISODE, PerCondition, agent_sizes, nan_frame, require, value_of
 from .dynamics import _with_steps, degenerate_reason, units, wideband_power
 from .stats import mann_whitney, nan_stat_row, spearman, wilcoxon_paired
 
@@ -78,6 +78,19 @@ def smaller_larger(dims: pd.DataFrame, steps: pd.DataFrame) -> pd.DataFrame:
     mixed = (by.transform("nunique") > 1).to_numpy()
     role = np.where(by.rank(method="min") == 1, "smaller", "larger")
     return d.assign(role=role)[mixed]
+
+
+#: Columns of :func:`power_roles` (docs/methods/analyses.md#analysis-dynamics).
+ROLE_COLUMNS = [*AGENT_EPISODE, "size", "role", "wideband_power", "reason"]
+
+
+def power_roles(dims: pd.DataFrame, steps: pd.DataFrame) -> pd.DataFrame:
+    """The wideband power of every agent-episode in an episode whose agents differ in size, with its ``size`` and
+    ``role`` (:func:`smaller_larger`; claim C21), columns :data:`ROLE_COLUMNS`; one NaN row that says why when there
+    is none."""
+    require(dims, [*AGENT_EPISODE, "wideband_power", "reason"], "dimensionality table")
+    roles = smaller_larger(dims, steps)[ROLE_COLUMNS]
+    return roles if len(roles) else nan_frame("no episode with agents of different sizes").reindex(columns=ROLE_COLUMNS)
 
 
 def power_tests(near_far: pd.DataFrame, dims: pd.DataFrame, steps: pd.DataFrame) -> pd.DataFrame:

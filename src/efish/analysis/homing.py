@@ -13,12 +13,15 @@ import pandas as pd
 from scipy import stats as sps
 
 from ..units import wrap
-from ._tables import AGENT_EPISODE, nan_frame, or_nan_row, require
-from .stats import mann_whitney
+from ._tables import AGENT_EPISODE, DEFAULTS, nan_frame, or_nan_row, require
+from .stats import mann_whitney, spearman
 
 #: Receptor class -> error-angle column of the steps table.
 ERROR_COLUMNS = {"morm": "err_morm_rad", "amp": "err_amp_rad", "knollen": "err_knollen_rad"}
 SHAPE_MEASURES = ("tortuosity", "curvature_rad_per_cm", "path_length_cm", "n_steps")
+#: Columns of :func:`alignment_episodes` (docs/methods/analyses.md#analysis-homing).
+ALIGNMENT_COLUMNS = [*AGENT_EPISODE, "channel", "success", "n_steps", "aligned_fraction", "straight_aligned_fraction",
+                     "aligned_excess", "alignment_rho", "reason"]
 
 
 def error_angles(steps: pd.DataFrame) -> pd.DataFrame:
@@ -73,6 +76,36 @@ def error_vs_time(steps: pd.DataFrame, bins: int = 10) -> pd.DataFrame:
     out["circmean_err_rad"] = wrap(g["err_rad"].agg(lambda e: sps.circmean(e, high=np.pi, low=-np.pi)).to_numpy())
     out["t_norm_mid"] = (out["bin"] + 0.5) / bins
     return or_nan_row(out.assign(reason=""), "no finite error angle")
+
+
+def alignment_episodes(steps: pd.DataFrame, aligned_rad: float = DEFAULTS.claims_aligned_rad) -> pd.DataFrame:
+    """How each agent-episode's error angles align with the target's field (Fig 2C,D; claims C2 and C3): one row per
+    agent-episode and receptor class with a finite error angle (columns :data:`ALIGNMENT_COLUMNS`).
+
+    Over its ``n_steps`` steps with a finite error angle: ``aligned_fraction``, the fraction whose error is within
+    ``aligned_rad`` of 0 or pi (|cos err| > cos ``aligned_rad``); ``straight_aligned_fraction``, the same for a
+    homer heading straight at the target from the same positions (error + ``bearing_agent_rad``, the geometric null;
+    a step without a bearing counts as not aligned); ``aligned_excess``, the first minus the second;
+    ``alignment_rho``, the Spearman rho of |sin err| against normalised time (:func:`error_angles`; negative: the
+    angle aligns over the episode), NaN with a ``reason`` under 3 steps or when either is constant. ``success``:
+    the agent-episode reached its goal (on any of its steps).
+    """
+    require(steps, [*AGENT_EPISODE, "t", "bearing_agent_rad", "success"], "steps table")
+    keys = [*AGENT_EPISODE, "channel"]
+    err = error_angles(steps).merge(steps[[*AGENT_EPISODE, "t", "bearing_agent_rad"]], on=[*AGENT_EPISODE, "t"])
+    straight = err["err_rad"] + err["bearing_agent_rad"]
+    err = err.assign(observed=np.abs(np.cos(err["err_rad"])) > np.cos(aligned_rad),
+                     straight=np.abs(np.cos(straight)) > np.cos(aligned_rad), abs_sin=np.abs(np.sin(err["err_rad"])))
+    g = err.groupby(keys, sort=True)
+    out = g.agg(n_steps=("t", "size"), aligned_fraction=("observed", "mean"),
+                straight_aligned_fraction=("straight", "mean")).reset_index()
+    out["aligned_excess"] = out["aligned_fraction"] - out["straight_aligned_fraction"]
+    rho = spearman(err.assign(unit=g.ngroup()), "t_norm", "abs_sin", by="unit").set_index("group")
+    out["alignment_rho"] = rho["effect"].reindex(out.index).to_numpy(np.float64)
+    out["reason"] = rho["reason"].reindex(out.index).fillna("").to_numpy()
+    success = steps.groupby(AGENT_EPISODE, sort=True)["success"].any()
+    out["success"] = success.reindex(pd.MultiIndex.from_frame(out[AGENT_EPISODE])).to_numpy(bool)
+    return or_nan_row(out[ALIGNMENT_COLUMNS], "no finite error angle")
 
 
 def trajectory_shape(steps: pd.DataFrame) -> pd.DataFrame:

@@ -162,22 +162,26 @@ def bite_timing(steps: pd.DataFrame, within_cm: float = DEFAULTS.bout_cm,
 
 
 def bite_rate_by_class(steps: pd.DataFrame, within_cm: float = DEFAULTS.bout_cm,
-                       facing_rad: float = DEFAULTS.facing_rad, away_rad: float = DEFAULTS.away_rad) -> pd.DataFrame:
+                       facing_rad: float = DEFAULTS.facing_rad, away_rad: float = DEFAULTS.away_rad,
+                       by: tuple[str, ...] = ("condition",)) -> pd.DataFrame:
     """Bites per pair-step by the biter's per-step label, over pairs within ``within_cm`` (Fig 5P).
 
     For each ordered pair-step (agent, partner) within range the agent either
     bit the partner (``bite_target`` == partner) or not; ``rate`` = bites /
-    ``n_steps`` per condition and label, NaN with a reason for a label never seen.
+    ``n_steps`` per condition (``by``: per condition and episode, claim C16's unit) and label, every label of
+    :data:`LABELS` listed for each with a pair within range, NaN with a reason for a label never seen.
     """
     require(steps, [*LABEL_COLUMNS, "bite_target"], "steps table")
+    keys = list(by)
     p = pairs(steps, ["heading_rad", "bite_target"])
     p = p[p["dist_cm"] <= within_cm]
     p = p.assign(label=_labels(p, facing_rad, away_rad), bit=p["bite_target"] == p["partner"])
     if p.empty:
-        return nan_frame(f"no pair of agents within {within_cm} cm", condition=np.nan, label=np.nan, n_steps=0,
-                         bites=0, rate=np.nan)
-    grid = pd.MultiIndex.from_product([sorted(p["condition"].unique()), LABELS], names=["condition", "label"])
-    out = p.groupby(["condition", "label"])["bit"].agg(n_steps="size", bites="sum").reindex(grid, fill_value=0)
+        return nan_frame(f"no pair of agents within {within_cm} cm", **dict.fromkeys(keys, np.nan), label=np.nan,
+                         n_steps=0, bites=0, rate=np.nan)
+    seen = p[keys].drop_duplicates().sort_values(keys).itertuples(index=False, name=None)
+    grid = pd.MultiIndex.from_tuples([(*unit, label) for unit in seen for label in LABELS], names=[*keys, "label"])
+    out = p.groupby([*keys, "label"])["bit"].agg(n_steps="size", bites="sum").reindex(grid, fill_value=0)
     out = out.reset_index()
     out["rate"] = np.divide(out["bites"], out["n_steps"], out=np.full(len(out), np.nan), where=out["n_steps"] > 0)
     out["reason"] = np.where(out["n_steps"] > 0, "", "label never seen within range")

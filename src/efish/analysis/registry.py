@@ -33,7 +33,7 @@ from ..config.recorded import recorded_conditions, step_rates
 from ..config.schema import AnalysisConfig, AssayConfig, EfishConfig
 from ..io import read_parquet
 from ..layout import ANALYSIS_SETTINGS, ROLLOUT_TABLES
-from ._tables import nan_frame, or_nan_row, require
+from ._tables import EPISODE, nan_frame, or_nan_row, require
 from .behaviour import (
     bite_matrix,
     eod_probability,
@@ -47,9 +47,17 @@ from .behaviour import (
     win_ratios,
 )
 from .decoding import decode_episodes, food_decode_episodes, summarise
-from .dynamics import dynamics_table, plsc_collapse_table, plsc_table, subsample_table
-from .dynamics_tests import power_near_far, power_tests, size_tests
-from .homing import ERROR_COLUMNS, compare_perception, error_histogram, error_vs_time, trajectory_shape
+from .dynamics import dynamics_table, plsc_collapse_table, plsc_episodes, plsc_table, subsample_table
+from .dynamics_tests import power_near_far, power_roles, power_tests, size_tests
+from .homing import (
+    ALIGNMENT_COLUMNS,
+    ERROR_COLUMNS,
+    alignment_episodes,
+    compare_perception,
+    error_histogram,
+    error_vs_time,
+    trajectory_shape,
+)
 from .interactions import bite_rate_by_class, bite_sizes, bite_timing, bouts, chase_sizes, label_counts, size_role_tests
 from .onepatch import food_from_steps, reach_tests, role_tests
 from .signalling import (
@@ -209,11 +217,13 @@ def _behaviour(t: Tables, a: AnalysisConfig, conditions: Conditions) -> Tables:
 
 
 # ----------------------------------------------------------- interactions
-BITE_OUTPUTS = ("bouts", "chase_sizes", "bite_sizes", "bite_timing", "bite_rate_by_class", "size_tests")
+BITE_OUTPUTS = ("bouts", "chase_sizes", "bite_sizes", "bite_timing", "bite_rate_by_class", "bite_rate_episodes",
+                "size_tests")
 
 
 def _interactions(t: Tables, a: AnalysisConfig, conditions: Conditions) -> Tables:
-    """Ethogram of pair labels, bouts, chaser and biter sizes, bite timing and rate by class (Figs 3A, 5K-P)."""
+    """Ethogram of pair labels, bouts, chaser and biter sizes, bite timing and rate by class, also per episode (Figs
+    3A, 5K-P)."""
     steps = t["steps"]
     labels = {"labels": label_counts(steps, a.facing_rad, a.away_rad)}
     if lacking := _lacking(steps, ["bite_target"], BITE_OUTPUTS, ["size_tests"]):
@@ -224,19 +234,23 @@ def _interactions(t: Tables, a: AnalysisConfig, conditions: Conditions) -> Table
             "bite_sizes": or_nan_row(bites, "no bites"),
             "bite_timing": or_nan_row(bite_timing(steps, bout_table=b), "no bite within a bout"),
             "bite_rate_by_class": bite_rate_by_class(steps, a.bout_cm, a.facing_rad, a.away_rad),
+            "bite_rate_episodes": bite_rate_by_class(steps, a.bout_cm, a.facing_rad, a.away_rad, by=EPISODE),
             "size_tests": size_role_tests(chases, bites)}
 
 
 # ----------------------------------------------------------------- homing
 def _homing(t: Tables, a: AnalysisConfig, conditions: Conditions) -> Tables:
-    """Error-angle histograms and time courses, trajectory shape, electric vs ray casting (Fig 2B-D); the homer is
-    the control condition's, as the run recorded it."""
+    """Error-angle histograms and time courses, their alignment per agent-episode, trajectory shape, electric vs ray
+    casting (Fig 2B-D); the homer is the control condition's, as the run recorded it."""
     steps = t["steps"]
     needs_one = [] if set(ERROR_COLUMNS.values()) & set(steps.columns) else ERROR_COLUMNS.values()
     errors = _lacking(steps, needs_one, ["error_histogram", "error_vs_time"]) or {
         "error_histogram": error_histogram(steps), "error_vs_time": error_vs_time(steps)}
+    lacking = _lacking(steps, [*needs_one, "bearing_agent_rad", "success"], ["alignment_episodes"])
+    alignment = (lacking["alignment_episodes"].reindex(columns=ALIGNMENT_COLUMNS) if lacking
+                 else alignment_episodes(steps, a.claims_aligned_rad))
     control = control_condition(steps["condition"], conditions)
-    return {**errors, "trajectory_shape": trajectory_shape(steps),
+    return {**errors, "alignment_episodes": alignment, "trajectory_shape": trajectory_shape(steps),
             "perception": compare_perception(steps, control, None, _homer(conditions.get(control)))}
 
 
@@ -256,9 +270,10 @@ def _onepatch(t: Tables, a: AnalysisConfig, conditions: Conditions) -> Tables:
 # --------------------------------------------------------------- dynamics
 def _dynamics(t: Tables, a: AnalysisConfig, conditions: Conditions) -> Tables:
     """Hidden-state dimensionality, power, unit subsampling, decoding per episode and its mean over episodes (also of
-    food near and far; homing: the homer's states), PLSC of agents 0 and 1 with the test of fewer shared dimensions
-    far than near, and the tests of D_eff against group size and of wideband power by context (Fig 6), each
-    condition's power per Hz of its recorded steps per second."""
+    food near and far; homing: the homer's states), PLSC of agents 0 and 1 (also its first component per episode
+    and distance bin) with the test of fewer shared dimensions far than near, wideband power by context and by
+    size, and the tests of D_eff against group size and of wideband power (Fig 6), each condition's power per Hz of
+    its recorded steps per second."""
     hidden, steps, fps = t["hidden"], t["steps"], step_rates(conditions)
     rng = np.random.default_rng(a.seed)
     dims = dynamics_table(hidden, a.variance_fraction, a.spectrogram_window, a.spectrogram_overlap, fps=fps)
@@ -272,6 +287,7 @@ def _dynamics(t: Tables, a: AnalysisConfig, conditions: Conditions) -> Tables:
             "food_decoding": summarise(food, by=("food",)), "food_decoding_episodes": food,
             "plsc": plsc_table(hidden, steps, (0, 1), a.plsc_edges_cm, a.plsc_shifts, rng, a.plsc_percentile,
                                a.plsc_null_draws, a.claims_alpha),
+            "plsc_episodes": plsc_episodes(hidden, steps, (0, 1), a.plsc_edges_cm),
             "plsc_collapse": plsc_collapse_table(hidden, steps, (0, 1), a.plsc_edges_cm, a.plsc_null_draws,
                                                  a.claims_alpha, swaps=a.plsc_label_swaps, rng=rng),
             "condition_tests": dunnett_by_measure(dims, DYNAMICS_MEASURES, "condition", control, a.seed),
@@ -280,14 +296,15 @@ def _dynamics(t: Tables, a: AnalysisConfig, conditions: Conditions) -> Tables:
 
 def _power(hidden: pd.DataFrame, steps: pd.DataFrame, dims: pd.DataFrame, a: AnalysisConfig,
            fps: Mapping[str, float]) -> Tables:
-    """Wideband power near vs far from the nearest conspecific, and its tests (Fig 6I,J); NaN rows without the
-    steps columns it needs."""
-    if lacking := _lacking(steps, ["dist_agent_cm", "size"], ["power_near_far", "power_tests"], ["power_tests"]):
+    """Wideband power near vs far from the nearest conspecific, of the smaller and the larger agents, and their tests
+    (Fig 6I,J); NaN rows without the steps columns it needs."""
+    if lacking := _lacking(steps, ["dist_agent_cm", "size"], ["power_near_far", "power_roles", "power_tests"],
+                           ["power_tests"]):
         return lacking
     near_far = power_near_far(hidden, steps, a.claims_near_cm, a.claims_far_cm, a.spectrogram_window,
                               a.spectrogram_overlap, fps)
     return {"power_near_far": or_nan_row(near_far, "no agent-episode with a hidden state"),
-            "power_tests": power_tests(near_far, dims, steps)}
+            "power_roles": power_roles(dims, steps), "power_tests": power_tests(near_far, dims, steps)}
 
 
 #: The assays whose food, bites, spacing and EOD probability the behaviour analysis summarises (Figs 3-5).
@@ -304,14 +321,15 @@ ANALYSES: dict[str, Analysis] = {a.name: a for a in [
     Analysis("interactions", _interactions, ("steps", "conditions"), ("patchy4", "square2"),
              ("labels", *BITE_OUTPUTS), ("size_tests",)),
     Analysis("homing", _homing, ("steps", "conditions"), ("homing",),
-             ("error_histogram", "error_vs_time", "trajectory_shape", "perception"), ("perception",)),
+             ("error_histogram", "error_vs_time", "alignment_episodes", "trajectory_shape", "perception"),
+             ("perception",)),
     Analysis("onepatch", _onepatch, ("steps", "conditions"), ("onepatch", "bot"),
              ("food_time_course", "reach_rates", "role_tests", "reach_tests"), ("role_tests", "reach_tests")),
     Analysis("dynamics", _dynamics, ("hidden", "steps", "conditions"),
              ("patchy4", "wide2", "homing", "groupsize", "square2"),
              ("dimensionality", "subsampling", "decoding", "decoding_episodes", "food_decoding",
-              "food_decoding_episodes", "plsc", "plsc_collapse", "condition_tests", "size_tests", "power_near_far",
-              "power_tests"), ("condition_tests", "size_tests", "power_tests")),
+              "food_decoding_episodes", "plsc", "plsc_episodes", "plsc_collapse", "condition_tests", "size_tests",
+              "power_near_far", "power_roles", "power_tests"), ("condition_tests", "size_tests", "power_tests")),
 ]}
 
 

@@ -11,9 +11,7 @@ import numpy as np
 import pandas as pd
 
 from ..analysis._tables import AGENT_EPISODE
-from ..analysis.homing import error_angles
-from ..analysis.stats import spearman
-from ..layout import analysis_table, assay_table
+from ..layout import analysis_table
 from .context import Context, claim
 from .parts import (
     mann_whitney_part,
@@ -23,7 +21,7 @@ from .verdicts import Outcome, Part
 
 HOMING_ELECTRIC, HOMING_RAYCAST = "electric", "raycast"  # config/assay/homing.yaml
 TRAJECTORY = analysis_table("homing", "homing", "trajectory_shape")
-HOMING_STEPS = assay_table("homing", "steps")
+ALIGNMENT = analysis_table("homing", "homing", "alignment_episodes")
 
 
 def _successful(frame: pd.DataFrame) -> pd.DataFrame:
@@ -46,55 +44,39 @@ def c1(ctx: Context) -> list[Part]:
                      "electric minus raycast; Mann-Whitney", compute)]
 
 
-def _knollen_errors(ctx: Context) -> pd.DataFrame:
-    """The homer's Knollenorgan error angles (long table of :func:`error_angles`) in the electric condition."""
-    steps = ctx.table(HOMING_STEPS)
-    steps = steps[steps["condition"] == HOMING_ELECTRIC]
-    err = error_angles(steps) if "err_knollen_rad" in steps.columns else pd.DataFrame()
-    err = err[err["channel"] == "knollen"] if len(err) else err
-    if err.empty:
-        raise ValueError("no finite Knollenorgan error angle in the electric homing steps")
-    return err
+def _aligned(ctx: Context) -> pd.DataFrame:
+    """The homing analysis's alignment rows (alignment_episodes) of the Knollenorgan error angle in the successful
+    agent-episodes of the electric condition (the homer's: the frozen target senses no error angle)."""
+    rows = ctx.table(ALIGNMENT)
+    rows = rows[(rows["condition"] == HOMING_ELECTRIC) & (rows["channel"] == "knollen")]
+    if rows.empty:
+        why = "; ".join(sorted({r for r in ctx.table(ALIGNMENT)["reason"] if isinstance(r, str) and r}))
+        raise ValueError("no finite Knollenorgan error angle in the electric homing steps" + (f" ({why})" if why else ""))
+    if (rows := rows[rows["success"].astype(bool)]).empty:
+        raise ValueError("no successful electric homing episode")
+    return rows
 
 
-
-@claim("C2", "2C", "the error angle is bimodal near parallel and anti-parallel to the target's field",
-       [HOMING_STEPS])
+@claim("C2", "2C", "the error angle is bimodal near parallel and anti-parallel to the target's field", [ALIGNMENT])
 def c2(ctx: Context) -> list[Part]:
     a = ctx.cfg.analysis.claims_aligned_rad
 
     def compute() -> Outcome:
-        err = _knollen_errors(ctx)
-        steps = ctx.table(HOMING_STEPS)[[*AGENT_EPISODE, "t", "success", "bearing_agent_rad"]]
-        err = _successful(err.merge(steps, on=[*AGENT_EPISODE, "t"]))
-        if err.empty:
-            raise ValueError("no successful electric homing episode")
-        # a homer heading straight at the target from the same position: heading + bearing to the target, so
-        # its error angle is the observed one plus the bearing (the geometric null of this statistic)
-        straight = err["err_rad"] + err["bearing_agent_rad"]
-        per = (err.assign(observed=np.abs(np.cos(err["err_rad"])) > np.cos(a),
-                          straight=np.abs(np.cos(straight)) > np.cos(a))
-               .groupby(["episode", "agent"], as_index=False)[["observed", "straight"]].mean())
-        per = per.assign(excess=per["observed"] - per["straight"])
-        out = one_sample_part(ctx, per, "excess", 0.0, +1)
-        note = (f"median aligned fraction {per['observed'].median():.3f} vs {per['straight'].median():.3f} for a "
-                f"straight homer on the same positions, over {len(per)} successful episodes")
+        per = _aligned(ctx)
+        out = one_sample_part(ctx, per, "aligned_excess", 0.0, +1)
+        note = (f"median aligned fraction {per['aligned_fraction'].median():.3f} vs "
+                f"{per['straight_aligned_fraction'].median():.3f} for a straight homer on the same positions, over "
+                f"{len(per)} successful episodes")
         return dataclasses.replace(out, reason="; ".join(r for r in (out.reason, note) if r))
     return [ctx.part("aligned beyond straight homing", f"Hodges-Lehmann estimate over successful episodes of the fraction of steps "
                      f"with |cos(err_knollen)| > cos({a:.3g}) minus that of a homer heading straight at the target "
                      "from the same positions; Wilcoxon vs 0", compute)]
 
 
-@claim("C3", "2D", "error angles align progressively during successful episodes", [HOMING_STEPS])
+@claim("C3", "2D", "error angles align progressively during successful episodes", [ALIGNMENT])
 def c3(ctx: Context) -> list[Part]:
     def compute() -> Outcome:
-        err = _successful(_knollen_errors(ctx).merge(
-            ctx.table(HOMING_STEPS)[[*AGENT_EPISODE, "t", "success"]], on=[*AGENT_EPISODE, "t"]))
-        if err.empty:
-            raise ValueError("no successful electric homing episode")
-        err = err.assign(abs_sin=np.abs(np.sin(err["err_rad"])), unit=err["episode"] * 1000 + err["agent"])
-        rho = spearman(err, "t_norm", "abs_sin", by="unit")
-        rho = rho.assign(episode=rho["group"] // 1000)[np.isfinite(rho["effect"])]
-        return one_sample_part(ctx, rho, "effect", 0.0, -1)
+        rho = _aligned(ctx)
+        return one_sample_part(ctx, rho[np.isfinite(rho["alignment_rho"])], "alignment_rho", 0.0, -1)
     return [ctx.part("alignment", "Hodges-Lehmann estimate over successful episodes of Spearman rho(|sin err_knollen|, normalised "
                      "time); Wilcoxon vs 0", compute)]

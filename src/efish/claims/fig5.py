@@ -12,7 +12,6 @@ import functools
 import numpy as np
 import pandas as pd
 
-from ..analysis.interactions import bite_rate_by_class
 from ..analysis.onepatch import REACH_CONTRASTS, bot_reach_counts, matched_alone, roles, social_conditions
 from ..layout import analysis_table, assay_table
 from .context import Context, claim
@@ -104,15 +103,13 @@ def c15(ctx: Context) -> list[Part]:
                      "(onepatch reach_tests)", functools.partial(_reach, ctx, "eod"))]
 
 
-SQUARE2_STEPS = assay_table("square2", "steps")
+SQUARE2_BITE_RATES = analysis_table("interactions", "square2", "bite_rate_episodes")
 
 
 def _confronting(ctx: Context) -> Outcome:
-    """Per-episode bite rate of confronting pair-steps minus the next-highest class, paired Wilcoxon over episodes."""
-    a, steps = ctx.cfg.analysis, ctx.table(SQUARE2_STEPS)
-    # bite_rate_by_class sums over a condition; each episode as its own condition gives per-episode rates
-    per = bite_rate_by_class(steps.assign(condition=steps["episode"]), a.bout_cm, a.facing_rad, a.away_rad)
-    per = per.rename(columns={"condition": "episode"}).dropna(subset=["label", "rate"])
+    """Per-episode bite rate of confronting pair-steps minus the next-highest class, paired Wilcoxon over episodes
+    (the interactions analysis's bite_rate_episodes)."""
+    per = ctx.table(SQUARE2_BITE_RATES).dropna(subset=["label", "rate"])
     per = per[per["label"] != "undefined"]
     pooled = per.groupby("label")[["bites", "n_steps"]].sum()
     if "confronting" not in pooled.index or len(pooled) < 2:
@@ -120,14 +117,14 @@ def _confronting(ctx: Context) -> Outcome:
     other = (pooled["bites"] / pooled["n_steps"]).drop("confronting").idxmax()
     # episodes where both classes occur within range: each episode is one paired unit, never pooled steps
     both = per[per["label"].isin(["confronting", other])]
-    both = both[both.groupby("episode")["label"].transform("nunique") == 2]
-    out = paired_difference(ctx, both, "confronting", other, value="rate", key="label", unit="episode")
+    both = both[both.groupby(["condition", "episode"])["label"].transform("nunique") == 2]
+    out = paired_difference(ctx, both, "confronting", other, value="rate", key="label")
     return dataclasses.replace(out, reason="; ".join(r for r in (out.reason, f"next-highest class: {other}") if r))
 
 
 @claim("C16", "5K-P", "larger agents chase; biting peaks early in bouts; confronting bouts bite most",
-       [analysis_table("interactions", "square2", t) for t in ("size_tests", "chase_sizes", "bite_timing")]
-       + [SQUARE2_STEPS])
+       [analysis_table("interactions", "square2", t) for t in ("size_tests", "chase_sizes", "bite_timing",
+                                                               "bite_rate_episodes")])
 def c16(ctx: Context) -> list[Part]:
     def timing() -> Outcome:
         bites = ctx.table(analysis_table("interactions", "square2", "bite_timing"))

@@ -15,18 +15,14 @@ import pandas as pd
 
 from ..analysis._tables import AGENT_EPISODE
 from ..analysis.decoding import FOOD_TARGETS, SENSED_TARGETS
-from ..analysis.dynamics import plsc
-from ..analysis.dynamics_tests import groupsize_parts, smaller_larger
-from ..layout import analysis_table, assay_table
+from ..analysis.dynamics_tests import groupsize_parts
+from ..layout import analysis_table
 from .context import Context, claim
 from .fig2 import HOMING_ELECTRIC
-from .fig3 import WIDE2_STEPS
 from .intervals import smallest_p_signed_rank
-from .parts import decoded, joined, one_sample_part, paired_difference, per_episode, spearman_part
+from .parts import decoded, one_sample_part, paired_difference, per_episode, spearman_part
 from .statistics import interaction_slope, rho_of
 from .verdicts import Outcome, Part
-
-WIDE2_HIDDEN = assay_table("wide2", "hidden")
 
 
 @claim("C17", "6A-C", "hidden dynamics are low-dimensional; D_eff grows with group size only with Knollenorgans",
@@ -119,37 +115,20 @@ def c19(ctx: Context) -> list[Part]:
 
 
 WIDE2_COLLAPSE = analysis_table("dynamics", "wide2", "plsc_collapse")
-
-
-def _pair_hidden(ctx: Context) -> tuple[pd.DataFrame, pd.DataFrame, list[str]]:
-    """Agents 0 and 1 of wide2 at their shared steps (same rows), with their distance ``dist_cm``."""
-    j, h = joined(ctx, WIDE2_HIDDEN, WIDE2_STEPS, ["x_cm", "y_cm"])
-    keys = ["condition", "episode", "t"]
-    a, b = (j[j["agent"] == i].set_index(keys) for i in (0, 1))
-    shared = a.index.intersection(b.index)
-    if shared.empty:
-        raise ValueError("agents 0 and 1 of wide2 share no step with a hidden state")
-    a, b = a.loc[shared], b.loc[shared]
-    dist = np.hypot(a["x_cm"] - b["x_cm"], a["y_cm"] - b["y_cm"]).rename("dist_cm")
-    return a.assign(dist_cm=dist).reset_index(), b.reset_index(), h
+WIDE2_PLSC_EPISODES = analysis_table("dynamics", "wide2", "plsc_episodes")
 
 
 @claim("C20", "6G,H", "the PLSC first-component correlation falls with pair distance; significant dimensions "
-       "collapse beyond 100 cm", [WIDE2_HIDDEN, WIDE2_STEPS, WIDE2_COLLAPSE])
+       "collapse beyond 100 cm", [WIDE2_PLSC_EPISODES, WIDE2_COLLAPSE])
 def c20(ctx: Context) -> list[Part]:
-    edges = [-np.inf, *ctx.cfg.analysis.plsc_edges_cm, np.inf]
-
     def falls() -> Outcome:
-        a, b, h = _pair_hidden(ctx)
-        rows = []
-        for (cond, ep), idx in a.groupby(["condition", "episode"]).indices.items():
-            d = a["dist_cm"].to_numpy()[idx]
-            for k in range(len(edges) - 1):
-                keep = idx[(d > edges[k]) & (d <= edges[k + 1])]
-                # shifts=1: only the first component's correlation is used, not the null
-                res = plsc(a[h].to_numpy()[keep], b[h].to_numpy()[keep], shifts=1, rng=ctx.rng)
-                rows.append({"condition": cond, "episode": ep, "bin": k, "r1": res["correlations"][0]})
-        per = per_episode(pd.DataFrame(rows).dropna(), "rho", rho_of("bin", "r1"))
+        """Per episode, the Spearman rho of its bins' first-component correlation (dynamics plsc_episodes) against
+        the bin."""
+        rows = ctx.table(WIDE2_PLSC_EPISODES)
+        if rows["episode"].isna().all():
+            raise ValueError("; ".join(sorted({r for r in rows["reason"] if isinstance(r, str) and r}))
+                             or f"no episode in {WIDE2_PLSC_EPISODES}")
+        per = per_episode(rows.dropna(subset=["r_1"]), "rho", rho_of("bin", "r_1"))
         return one_sample_part(ctx, per, "rho", 0.0, -1)
 
     def collapse() -> Outcome:
@@ -172,11 +151,11 @@ def c20(ctx: Context) -> list[Part]:
 
 
 POWER_NEAR_FAR = analysis_table("dynamics", "wide2", "power_near_far")
-WIDE2_DIMS = analysis_table("dynamics", "wide2", "dimensionality")
+POWER_ROLES = analysis_table("dynamics", "wide2", "power_roles")
 
 
 @claim("C21", "6I,J", "a nearby conspecific lowers wideband power; smaller agents carry more",
-       [POWER_NEAR_FAR, WIDE2_DIMS, WIDE2_STEPS])
+       [POWER_NEAR_FAR, POWER_ROLES])
 def c21(ctx: Context) -> list[Part]:
     a = ctx.cfg.analysis
 
@@ -188,8 +167,9 @@ def c21(ctx: Context) -> list[Part]:
         return one_sample_part(ctx, per_episode(diff, "diff"), "diff", 0.0, +1)
 
     def smaller() -> Outcome:
-        """Per episode, the smaller agent's wideband power minus the larger's (paired within the episode)."""
-        d = smaller_larger(ctx.table(WIDE2_DIMS), ctx.table(WIDE2_STEPS)).dropna(subset=["wideband_power"])
+        """Per episode, the smaller agent's wideband power minus the larger's (paired within the episode; dynamics
+        power_roles)."""
+        d = ctx.table(POWER_ROLES).dropna(subset=["wideband_power"])
         by_role = d.pivot_table(index=["condition", "episode"], columns="role", values="wideband_power")
         by_role = by_role.reindex(columns=["smaller", "larger"]).dropna()
         diff = (by_role["smaller"] - by_role["larger"]).rename("diff").reset_index()

@@ -18,8 +18,6 @@ from collections.abc import Callable, Iterable
 import numpy as np
 import pandas as pd
 
-from ..analysis._tables import AGENT_EPISODE
-from ..analysis.dynamics import units
 from ..analysis.stats import mann_whitney, signed_rank_test, spearman
 from .context import Context
 from .intervals import (
@@ -146,13 +144,6 @@ def one_sample_part(ctx: Context, frame: pd.DataFrame, value: str, reference: fl
     """Signed-rank test of ``value`` against ``reference``, one value per row of ``frame`` (effect: the
     Hodges-Lehmann estimate of value - reference; :func:`signed_rank_outcome`)."""
     return signed_rank_outcome(ctx, frame[value].to_numpy(np.float64) - reference, sign, units_=units_)
-
-
-def joined(ctx: Context, hidden: str, steps: str, columns: list[str]) -> tuple[pd.DataFrame, list[str]]:
-    """Hidden rows joined with ``columns`` of the steps table (keys condition, episode, agent, t), and the units."""
-    h, s = ctx.table(hidden), ctx.table(steps)
-    keys = [*AGENT_EPISODE, "t"]
-    return h.merge(s[keys + columns], on=keys).sort_values(keys, kind="stable"), units(h)
 
 
 def paired_difference(ctx: Context, long: pd.DataFrame, better: str, worse: str, value: str = "skill",

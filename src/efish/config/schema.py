@@ -481,8 +481,8 @@ class AnalysisConfig:
     claims_seed: int = param(0, "claims: seed of the bootstrap (with the claim's number, so reruns are identical)",
                              lo=0)
     claims_alpha: float = param(0.05, "claims: a test is significant at p below this", lo=0.0, hi=1.0)
-    claims_aligned_rad: float = param(math.pi / 4, "claims C2: |error| within this of 0 or pi counts as aligned, "
-                                      "rad", lo=0.0, hi=math.pi / 2)
+    claims_aligned_rad: float = param(math.pi / 4, "homing alignment_episodes (claim C2): |error| within this of 0 "
+                                      "or pi counts as aligned, rad", lo=0.0, hi=math.pi / 2)
     claims_margin_fraction: float = param(0.2, "claims: equivalence margin of a 'no difference' part (TOST), as a "
                                           "fraction of the control's median", lo=0.0)
     claims_margin_sd: float = param(0.5, "claims: equivalence margin in pooled SDs, used where the control's median "
