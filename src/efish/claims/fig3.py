@@ -12,7 +12,7 @@ import pandas as pd
 from scipy import stats as sps
 
 from ..analysis.signalling import EVENTS, power_law_vs_exponential_clustered
-from ..layout import analysis_table, assay_table
+from ..layout import analysis_table
 from .context import Context, claim
 from .parts import one_sample_part, per_episode, slope_of, spearman_part, stat_row
 from .statistics import rho_of
@@ -46,7 +46,6 @@ def c4(ctx: Context) -> list[Part]:
                      "across episodes", compute)]
 
 
-WIDE2_STEPS = assay_table("wide2", "steps")  # the claims of Fig 6 read it
 RATE_BY_DISTANCE = analysis_table("signalling", "wide2", "rate_by_distance_episodes")
 PERI_EVENT = analysis_table("signalling", "wide2", "peri_event_episodes")
 
