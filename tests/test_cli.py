@@ -78,12 +78,14 @@ def test_efish_claims_adds_the_verdicts_of_the_other_top_seeds(seed_run, capsys)
     table = pd.read_parquet(out / "claims.parquet").set_index("claim")
     assert list(table.reset_index().columns) == [*ROW_COLUMNS[:2], *RECIPE_COLUMNS, *ROW_COLUMNS[2:9], "seed_verdicts",
                                                  "seeds_agree", "reason"]
-    # the recipe: C9's effects 0.4 (seed 3), 0.2 and 0.5 over three seeds (t = 4.2, 2 df, p = 0.053); C1 ran at one
+    # the recipe: C9's effects 0.4 (seed 3), 0.2 and 0.5 over three seeds (t = 4.2, 2 df, p = 0.053)
     assert table.loc["C9", "recipe_seeds"] == 3 and table.loc["C9", "recipe_effect"] == pytest.approx(1.1 / 3)
     assert table.loc["C9", "recipe_verdict"] == "weaker" and table.loc["C9", "recipe_p"] == pytest.approx(0.053, abs=1e-3)
-    assert table.loc["C1", "recipe_verdict"] == "not run"
+    # C1 ran at the selected seed alone (as the homing claims do): one draw, said so
+    assert table.loc["C1", "recipe_verdict"] == "holds" and table.loc["C1", "recipe_seeds"] == 1
+    assert "one draw" in table.loc["C1", "recipe_reason"]
     recipe = pd.read_parquet(out / "recipe_parts.parquet")
-    assert list(recipe.columns) == RECIPE_PART_COLUMNS and recipe["seeds"].tolist() == ["3, 1, 7"] * 2
+    assert list(recipe.columns) == RECIPE_PART_COLUMNS and recipe["seeds"].tolist() == ["3", "3, 1, 7"]
     assert table.loc["C9", "seed_verdicts"] == "seed 3: holds; seed 1: weaker; seed 7: holds"  # ranking order
     assert table.loc["C9", "seeds_agree"] == "2/3 hold, 1/3 weaker"
     assert "flips between seeds" in table.loc["C9", "reason"]
@@ -91,7 +93,7 @@ def test_efish_claims_adds_the_verdicts_of_the_other_top_seeds(seed_run, capsys)
     page = (out / "claims.md").read_text()
     assert "| selected seed's verdict | seeds_agree | reason | recipe reason |" in page
     assert "| holds | 2/3 hold, 1/3 weaker |" in page and "| C9 | 3O | weaker | 0.367 [" in page
-    assert "The recipe (its top seeds together): 1 weaker, 1 not run. The selected seed: 2 holds." in page
+    assert "The recipe (its top seeds together): 1 holds, 1 weaker. The selected seed: 2 holds." in page
     assert "selected seed 3, other top seeds 1, 7" in page.splitlines()[0]
     assert "seeds_agree" in capsys.readouterr().out
 

@@ -127,3 +127,13 @@ def test_bad_parts_tables_are_one_line_errors():
         recipe_parts(seeds_of([0.1, 0.2]), 9, ALPHA)
     with pytest.raises(ValueError, match="lacks columns"):
         recipe_parts({1: part_table({"a": 0.1}).drop(columns="p_floor"), 2: part_table({"a": 0.2})}, 1, ALPHA)
+
+
+def test_a_claim_no_other_seed_runs_is_one_draw_not_a_missing_recipe():
+    """The homing claims run once (their policies do not depend on the seed): the recipe keeps the selected
+    seed's part and says it is one draw; a part another seed ran but this one did not still needs two seeds."""
+    seeds = {1: part_table({"a": 0.5}, verdict="holds", claim="C1"), 2: part_table({"a": np.nan}, verdict="not run",
+                                                                                  claim="C1")}
+    row = recipe_parts(seeds, 1, ALPHA).iloc[0]
+    assert row["verdict"] == "holds" and row["n"] == 1 and row["effect"] == 0.5 and "one draw" in row["reason"]
+

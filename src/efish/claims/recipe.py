@@ -32,7 +32,10 @@ fails, or not decidable *only* because its n could not reach significance (the
 recipe pools what one seed could not carry); a seed where the part did not run
 or the data could not carry it (a ceiling, a floor) is left out and named.
 Fewer than :data:`MIN_SEEDS` seeds: the recipe's part is not decidable (a seed
-was at a ceiling or floor) or not run. The claim's recipe verdict combines its
+was at a ceiling or floor) or not run. A claim no other seed runs at all (the
+homing claims, whose policies are trained once and not per seed) keeps the
+selected seed's parts, marked as one draw; a run with no other top seed has no
+recipe's verdict (not run). The claim's recipe verdict combines its
 parts' by :func:`~efish.claims.verdicts.combined_verdict`.
 
 Pure pandas and scipy: it reads claim_parts tables, never the simulator.
@@ -169,10 +172,14 @@ def recipe_parts(parts_by_seed: Mapping[int, pd.DataFrame], selected: int, alpha
                              "(efish claims) with this efish version")
     order = [selected, *[s for s in parts_by_seed if s != selected]]
     stacked = pd.concat([parts_by_seed[s].assign(seed=s) for s in order], ignore_index=True)
+    others_ran = set(stacked.loc[(stacked["seed"] != selected) & (stacked["verdict"] != "not run"), "claim"])
     rows = []
     for (claim, part), group in stacked.groupby(["claim", "part"], sort=False):
         if group["seed"].iloc[0] != selected:
             continue  # a part only another seed has: the selected seed's claims set the list
+        if len(order) > 1 and claim not in others_ran:  # other seeds ran, not this claim (homing): one draw
+            rows.append(_one_draw(group.iloc[0]))
+            continue
         missing = [s for s in order if s not in set(group["seed"])]
         group = pd.concat([group, pd.DataFrame({"claim": claim, "part": part, "seed": missing, "verdict": "not run",
                                                 "effect": np.nan, "p_floor": np.nan})], ignore_index=True)
@@ -189,6 +196,18 @@ def recipe_parts(parts_by_seed: Mapping[int, pd.DataFrame], selected: int, alpha
                      "reason": found.reason})
     return pd.DataFrame(rows, columns=RECIPE_PART_COLUMNS).astype({"n": "int64", "family": "int64",
                                                                    "decides": bool})
+
+
+def _one_draw(row: pd.Series) -> dict:
+    """The recipe row of a part only the selected seed ran, because no other seed runs its claim (the homing
+    claims: their policies are trained once, not per seed): that one draw's verdict, said to be one draw."""
+    note = "one draw: no other seed runs this claim (its policies do not depend on the seed)"
+    return {"claim": row["claim"], "part": row["part"], "statistic": row["statistic"], "sign": row["sign"],
+            "effect": row["effect"], "ci_low": row["ci_low"], "ci_high": row["ci_high"],
+            "ci_method": row["ci_method"], "n": 1, "p": row["p"], "family": int(row["family"]), "tau": np.nan,
+            "margin": row["margin"], "verdict": row["verdict"], "decides": bool(row["decides"]),
+            "seeds": str(int(row["seed"])), "seed_effects": f"{row['effect']:.3g}",
+            "reason": "; ".join(r for r in (note, row["reason"]) if isinstance(r, str) and r)}
 
 
 def _as_part(row: pd.Series) -> Part:
