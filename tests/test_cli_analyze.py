@@ -51,7 +51,7 @@ def test_the_same_command_gives_the_same_tables(assay_folder, tmp_path):
 
 
 @pytest.mark.parametrize("args, message", [
-    (["behaviour"], "episodes.parquet, which does not exist"),
+    (["behaviour"], "episodes.parquet, "),  # and food.parquet: the message names every missing table
     (["nope"], "unknown analysis 'nope'"),
     (["behaviour", "analysis.rate_bins=0"], "analysis.rate_bins=0 is out of range"),
 ])

@@ -238,7 +238,7 @@ def test_bad_names_and_missing_tables_are_one_line(tmp_path, tables):
         get("nope")
     tables["steps"].to_parquet(tmp_path / "steps.parquet")
     tables["conditions"].to_parquet(tmp_path / "conditions.parquet")
-    with pytest.raises(ValueError, match=r"needs .*episodes\.parquet, which does not exist"):
+    with pytest.raises(ValueError, match=r"needs .*episodes\.parquet, .*food\.parquet, which does not exist"):
         read_tables("behaviour", tmp_path)
     with pytest.raises(ValueError, match=r"needs the tables \['hidden'\]"):
         run("dynamics", {"steps": tables["steps"], "conditions": tables["conditions"]}, cfg_with().analysis)

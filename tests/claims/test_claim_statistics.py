@@ -87,11 +87,12 @@ def test_excess_theil_is_zero_on_average_for_equal_shares_at_any_total():
 
 def test_a_condition_that_eats_every_pellet_is_at_a_ceiling():
     summary = pd.DataFrame({"condition": ["c"] * 4 + ["t"] * 4, "episode": np.tile(np.arange(4), 2),
-                            "food_total": [6, 6, 6, 5, 3, 4, 2, 6]})
-    food = summary[["condition", "episode"]].loc[summary.index.repeat(6)]
-    full, how = at_ceiling(summary, food, "c", 0.5)
+                            "food_total": [6, 6, 6, 5, 3, 4, 2, 6], "food_offered": 6})
+    full, how = at_ceiling(summary, "c", 0.5)
     assert full and "75%" in how
-    assert not at_ceiling(summary, food, "t", 0.5)[0]
+    assert not at_ceiling(summary, "t", 0.5)[0]
+    with pytest.raises(ValueError, match="no food_offered column: rerun the behaviour analysis"):
+        at_ceiling(summary.drop(columns="food_offered"), "c", 0.5)
 
 
 def test_interaction_slope_recovers_the_difference_of_slopes():

@@ -82,15 +82,12 @@ def episodes_table(spec: dict[str, dict[str, float]], name: str, episodes: int =
     return pd.DataFrame(rows)
 
 
-def food_records(summary: pd.DataFrame, offered: int) -> pd.DataFrame:
-    """A food table with ``offered`` pellets per (condition, episode) of ``summary``."""
-    keys = summary[["condition", "episode"]].drop_duplicates()
-    return keys.loc[keys.index.repeat(offered)].assign(pellet=np.tile(np.arange(offered), len(keys)))
-
-
 def behaviour_tables(assay: str, spec: dict, control: str, episodes: int = 15, offered: int = 60) -> dict:
-    summary = episode_summary(episodes_table(spec, assay, episodes))
-    return {A("behaviour", assay, "episode_summary"): summary, R(assay, "food"): food_records(summary, offered)}
+    """The behaviour analysis's episode summary of ``assay``, every episode offered ``offered`` pellets."""
+    episodes = episodes_table(spec, assay, episodes)
+    food = episodes[["condition", "episode"]].drop_duplicates()
+    food = food.loc[food.index.repeat(offered)].assign(pellet=np.tile(np.arange(offered), len(food)))
+    return {A("behaviour", assay, "episode_summary"): episode_summary(episodes, food)}
 
 
 def c1(flip):
@@ -531,7 +528,7 @@ def test_a_paired_design_decides_where_an_unpaired_test_sees_nothing():
              "mean_nn_dist_cm": 20 + (2 if c == "muted" else 0) + rng.normal(0, .5)}
             for c in ("intact", "muted") for e in range(30)]
     summary = pd.DataFrame(rows)
-    tables = {A("behaviour", "mute", "episode_summary"): summary, R("mute", "food"): food_records(summary, 90)}
+    tables = {A("behaviour", "mute", "episode_summary"): summary.assign(food_offered=90)}
     from scipy.stats import mannwhitneyu
 
     x, c = (summary.loc[summary["condition"] == k, "food_total"] for k in ("muted", "intact"))
@@ -548,11 +545,8 @@ def test_a_control_at_the_ceiling_makes_food_parts_not_decidable():
     control = summary["condition"] == "control"
     ceiling = summary.assign(food_total=np.where(control, summary["food_total"].round(), summary["food_total"]))
     # as many pellets as the control ate in each episode; plenty for the other conditions
-    food = pd.concat([pd.DataFrame({"condition": "control", "episode": e, "pellet": np.arange(int(n))})
-                      for e, n in zip(ceiling.loc[control, "episode"], ceiling.loc[control, "food_total"], strict=True)]
-                     + [food_records(summary[~control], 60)])
-    row = cl.CLAIMS["C11"].run({**tables, A("behaviour", "collective", "episode_summary"): ceiling,
-                                R("collective", "food"): food}, CFG)
+    ceiling = ceiling.assign(food_offered=np.where(control, ceiling["food_total"], 60))
+    row = cl.CLAIMS["C11"].run({**tables, A("behaviour", "collective", "episode_summary"): ceiling}, CFG)
     assert "food, self-only: not decidable" in row["reason"] and "at a ceiling" in row["reason"]
     assert "EOD probability, self-only: holds" in row["reason"]
     # what could not be tested cannot carry the claim (rule 9): the EOD parts hold, the claim is weaker at best
@@ -566,7 +560,7 @@ def test_no_difference_is_shown_equivalent_only_when_n_allows_it(episodes, expec
     rng = np.random.default_rng(episodes)
     summary = pd.DataFrame([{"condition": c, "episode": e, "food_total": 20 + rng.normal(0, 6), "eod_probability": 0.3,
                              "bites": 1.0, "mean_nn_dist_cm": 20.0} for c in ("M_A_K", "M_A") for e in range(episodes)])
-    tables = {A("behaviour", "ablation4", "episode_summary"): summary, R("ablation4", "food"): food_records(summary, 90)}
+    tables = {A("behaviour", "ablation4", "episode_summary"): summary.assign(food_offered=90)}
     part = cl.CLAIMS["C10"].run(tables, CFG)["reason"].split("; group food, K off (equivalent): ")[1]
     assert part.startswith(expected), part
 
@@ -577,7 +571,8 @@ def test_the_authors_self_only_mode_is_reported_beside_and_does_not_decide():
     authors = summary[summary["condition"] == "self_only"].assign(condition="self_only_authors",
                                                                    food_total=summary["food_total"].max() * 3)
     tables[A("behaviour", "collective", "episode_summary")] = pd.concat([summary, authors], ignore_index=True)
-    tables[R("collective", "food")] = food_records(tables[A("behaviour", "collective", "episode_summary")], 200)
+    tables[A("behaviour", "collective", "episode_summary")] = tables[A("behaviour", "collective",
+                                                                        "episode_summary")].assign(food_offered=200)
     row = cl.CLAIMS["C11"].run(tables, CFG)
     assert "food, self-only (authors' mode) (beside, not deciding): fails" in row["reason"]
     assert row["verdict"] == "holds"
@@ -907,7 +902,7 @@ def paired_summary(control: list[float], other: list[float], measure: str = "foo
 
 def mute_tables(control: list[float], other: list[float]) -> dict:
     summary = paired_summary(control, other)
-    return {A("behaviour", "mute", "episode_summary"): summary, R("mute", "food"): food_records(summary, 90)}
+    return {A("behaviour", "mute", "episode_summary"): summary.assign(food_offered=90)}
 
 
 @pytest.mark.parametrize("flip", [False, True], ids=["the paper's sign", "the opposite sign"])
@@ -958,7 +953,7 @@ def test_all_zero_differences_go_to_the_equivalence_test():
     spec = [{"condition": c, "episode": e, "food_total": v, "eod_probability": 0.3, "bites": 1.0,
              "mean_nn_dist_cm": 20.0} for c in ("M_A_K", "M_A") for e, v in enumerate(base)]
     summary = pd.DataFrame(spec)
-    tables = {A("behaviour", "ablation4", "episode_summary"): summary, R("ablation4", "food"): food_records(summary, 60)}
+    tables = {A("behaviour", "ablation4", "episode_summary"): summary.assign(food_offered=60)}
     parts = {p.label: p for p in cl.CLAIMS["C10"].assess(tables, CFG)[1]}
     k_off = parts["group food, K off (equivalent)"]
     assert k_off.verdict == "holds" and k_off.p == pytest.approx(1 / 2 ** 12)

@@ -175,14 +175,20 @@ def eod_probability(steps: pd.DataFrame) -> pd.DataFrame:
     return out.drop(columns="median").rename(columns={"mean": "eod_probability"})
 
 
-def episode_summary(episodes: pd.DataFrame) -> pd.DataFrame:
-    """One row per episode: total food, food per agent, Theil T, mean EOD probability, spacing and bites (Fig 4)."""
+def episode_summary(episodes: pd.DataFrame, food: pd.DataFrame | None = None) -> pd.DataFrame:
+    """One row per episode: total food, food per agent, Theil T, mean EOD probability, spacing and bites (Fig 4);
+    with the ``food`` table (one row per pellet that existed, regrown ones included) also ``food_offered``, the
+    pellets the episode had (0 where the food table has none), so a reader can tell a ceiling (every pellet
+    eaten) from the summary alone."""
     cols = ["eod_probability", "mean_nn_dist_cm", "bites_given"]
     require(episodes, [*EPISODE, "food_eaten", *cols], "episodes table")
     g = episodes.groupby(EPISODE, sort=True)
     out = g.agg(n_agents=("food_eaten", "size"), food_total=("food_eaten", "sum"),
                 food_per_agent=("food_eaten", "mean"), eod_probability=("eod_probability", "mean"),
                 mean_nn_dist_cm=("mean_nn_dist_cm", "mean"), bites=("bites_given", "sum")).reset_index()
+    if food is not None:
+        offered = food.groupby(EPISODE).size()
+        out["food_offered"] = out.set_index(EPISODE).index.map(offered).fillna(0).astype(np.int64)
     theil = theil_per_episode(episodes)
     # both are sorted by (condition, episode) with one row per episode, so they align row by row
     return out.assign(theil_t=theil["theil_t"].to_numpy(), reason=theil["reason"].to_numpy())

@@ -199,7 +199,7 @@ def _signalling(t: Tables, a: AnalysisConfig, conditions: Conditions) -> Tables:
 def _behaviour(t: Tables, a: AnalysisConfig, conditions: Conditions) -> Tables:
     """Food, food vs size, Theil T, win ratios, bites by size, spacing, EOD probability, condition tests (Figs 3-4)."""
     episodes, steps = t["episodes"], t["steps"]
-    wins, eod, summary = win_ratios(episodes), eod_probability(steps), episode_summary(episodes)
+    wins, eod, summary = win_ratios(episodes), eod_probability(steps), episode_summary(episodes, t["food"])
     control = control_condition(summary["condition"], conditions)
     bites = _lacking(steps, ["bite_target"], ["bite_matrix"]) or {"bite_matrix": bite_matrix(steps)}
     theil = theil_per_episode(episodes)
@@ -314,7 +314,7 @@ ANALYSES: dict[str, Analysis] = {a.name: a for a in [
     Analysis("signalling", _signalling, ("steps", "conditions"), ("patchy4", "wide2"),
              ("idis", "idi_histogram", "power_law", "rate_by_distance", "rate_by_distance_episodes", "peri_event",
               "peri_event_episodes", "rate_advantage", "rate_tests"), ("rate_tests",)),
-    Analysis("behaviour", _behaviour, ("steps", "episodes", "conditions"), FORAGING,
+    Analysis("behaviour", _behaviour, ("steps", "episodes", "food", "conditions"), FORAGING,
              ("food_per_agent", "food_vs_size", "theil", "win_ratio", "bite_matrix", "nearest_neighbour",
               "eod_probability", "episode_summary", "size_tests", "condition_tests"),
              ("food_vs_size", "size_tests", "condition_tests")),

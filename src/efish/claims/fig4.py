@@ -17,7 +17,7 @@ import re
 
 import pandas as pd
 
-from ..layout import analysis_table, assay_table
+from ..layout import analysis_table
 from .context import Context, claim
 from .parts import ceiling, mann_whitney_part, margin_for, paired_part, present, spearman_part
 from .statistics import excess_theil_per_episode, pooled_sd, welch_tost
@@ -40,7 +40,7 @@ def _vs_control(ctx: Context, assay: str, condition: str, control: str, measure:
     s = summary(ctx, assay)
     s = s[s["condition"].isin([*family, control])]
     if measure == FOOD:
-        if (at := ceiling(ctx, s, ctx.table(assay_table(assay, "food")), [control])) is not None:
+        if (at := ceiling(ctx, s, [control])) is not None:
             return at
     return paired_part(ctx, s, measure, condition, control, sign, family)
 
@@ -64,8 +64,7 @@ def _parts(ctx: Context, control: str, specs: list[Spec], decides: bool = True) 
 
 
 def _tables(assays, tables=("episode_summary",)) -> list[str]:
-    return ([analysis_table("behaviour", a, t) for a in assays for t in tables]
-            + [assay_table(a, "food") for a in assays])
+    return [analysis_table("behaviour", a, t) for a in assays for t in tables]
 
 
 @claim("C10", "4A-F", "short-range ablations cut food; Knollenorgan ablation keeps food, raises EOD probability "

@@ -228,11 +228,11 @@ def unpaired_equivalence(ctx: Context, frame: pd.DataFrame, value: str, group: s
     return _with_margin(out, margin, tost_unpaired(x, c, margin[0]), smallest_p_rank_sum(x.size, c.size, sides=1))
 
 
-def ceiling(ctx: Context, summary: pd.DataFrame, food: pd.DataFrame, conditions: Iterable[str]) -> Outcome | None:
+def ceiling(ctx: Context, summary: pd.DataFrame, conditions: Iterable[str]) -> Outcome | None:
     """A "not decidable" outcome when one of ``conditions`` ate every pellet in most episodes (a ceiling), else None."""
     share = ctx.cfg.analysis.claims_ceiling_share
     for condition in conditions:
-        full, how = at_ceiling(summary, food, condition, share)
+        full, how = at_ceiling(summary, condition, share)
         if full:
             return Outcome(np.nan, np.nan, int((summary["condition"] == condition).sum()), None,
                            verdict="not decidable", reason=f"at a ceiling: {how}, so no food difference can appear")

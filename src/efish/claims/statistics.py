@@ -274,17 +274,19 @@ def excess_theil_per_episode(per_agent: pd.DataFrame, value: str = "food_eaten",
 
 
 # ------------------------------------------------------------------ ceilings
-def eaten_fraction(summary: pd.DataFrame, food: pd.DataFrame, eaten: str = "food_total") -> pd.Series:
-    """Per (condition, episode): pellets eaten / pellets that existed (the food table's records), NaN for none."""
-    offered = food.groupby(["condition", "episode"]).size().rename("offered")
-    joined = summary.set_index(["condition", "episode"])[[eaten]].join(offered)
-    return (joined[eaten] / joined["offered"].where(joined["offered"] > 0)).rename("eaten_fraction")
+def eaten_fraction(summary: pd.DataFrame, eaten: str = "food_total") -> pd.Series:
+    """Per (condition, episode) of the behaviour analysis's episode summary: pellets eaten / pellets that existed
+    (its ``food_offered``), NaN for none."""
+    if "food_offered" not in summary.columns:
+        raise ValueError("the episode summary has no food_offered column: rerun the behaviour analysis")
+    joined = summary.set_index(["condition", "episode"])
+    return (joined[eaten] / joined["food_offered"].where(joined["food_offered"] > 0)).rename("eaten_fraction")
 
 
-def at_ceiling(summary: pd.DataFrame, food: pd.DataFrame, condition: str, share: float) -> tuple[bool, str]:
+def at_ceiling(summary: pd.DataFrame, condition: str, share: float) -> tuple[bool, str]:
     """Whether ``condition`` ate every pellet there was in at least ``share`` of its episodes (a ceiling), and a
     sentence saying how often it did."""
-    frac = eaten_fraction(summary, food)
+    frac = eaten_fraction(summary)
     mine = frac.xs(condition, level="condition").dropna() if condition in frac.index.get_level_values(0) else frac[:0]
     if mine.empty:
         return False, f"no pellet record for {condition}"
