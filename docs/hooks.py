@@ -88,6 +88,7 @@ def _codes(columns) -> str:
 def tables_reference() -> str:
     """Markdown: the columns of every rollout table (``efish schema``), of the analysis settings table and of the
     claims tables."""
+    from efish.analysis.registry import ANALYSES
     from efish.analysis.selection import RANKING_COLUMNS
     from efish.claims.recipe import RECIPE_COLUMNS, RECIPE_PART_COLUMNS
     from efish.claims.seeds import SEED_COLUMNS
@@ -104,6 +105,14 @@ def tables_reference() -> str:
         if name == "hidden":
             out.append(f"| `h_0`, `h_1`, ... | `float` | {html.escape(HIDDEN_UNITS)} |")
         out.append("")
+    out += ["## The analysis tables {#analysis-tables}", "",
+            "Every analysis writes these tables under `results/{run}/analysis/<analysis>/<assay>/` for each assay "
+            "it belongs to (`efish.analysis.registry.ANALYSES`); their columns and how each is computed are on "
+            "[the analyses page](../methods/analyses.md).", "",
+            "| analysis | reads | assays | tables |", "|---|---|---|---|"]
+    out += [f"| [`{a.name}`](../methods/analyses.md#analysis-{a.name}) | {_codes(a.reads)} | {_codes(a.assays)} | "
+            f"{_codes(a.outputs)} |" for a in ANALYSES.values()]
+    out.append("")
     out += [f"## `{ANALYSIS_SETTINGS}.parquet`: the settings an analysis job ran with {{#analysis-settings}}", "",
             f"`efish analyze` writes it beside the tables of every analysis of an assay "
             f"(`{analysis_settings('<analysis>', '<assay>')}`): one row, whose `{SETTINGS_COLUMN}` column holds "
