@@ -34,8 +34,8 @@ or the data could not carry it (a ceiling, a floor) is left out and named.
 Fewer than :data:`MIN_SEEDS` seeds: the recipe's part is not decidable (a seed
 was at a ceiling or floor) or not run. A claim no other seed runs at all (the
 homing claims, whose policies are trained once and not per seed) keeps the
-selected seed's parts, marked as one draw; a run with no other top seed has no
-recipe's verdict (not run). The claim's recipe verdict combines its
+selected seed's parts, marked as one draw; a run with no other top seed decides
+no recipe part (each is not run, or not decidable where the seed's was). The claim's recipe verdict combines its
 parts' by :func:`~efish.claims.verdicts.combined_verdict`.
 
 Pure pandas and scipy: it reads claim_parts tables, never the simulator.
