@@ -50,6 +50,7 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
+from .seeds import seed_list
 from .verdicts import NAN_CI, PART_COLUMNS, Part, combine, judge
 
 __all__ = ["MIN_SEEDS", "RECIPE_COLUMNS", "RECIPE_PART_COLUMNS", "recipe_parts", "pooled", "with_recipe_verdicts"]
@@ -121,10 +122,6 @@ def _usable(rows: pd.DataFrame, alpha: float) -> pd.Series:
     return np.isfinite(rows["effect"].astype(float)) & (rows["verdict"].isin(DECIDED) | too_small)
 
 
-def _seeds_text(seeds, selected: int) -> str:
-    return ", ".join(f"{s} (selected)" if s == selected else str(s) for s in seeds)
-
-
 def _recipe_part(rows: pd.DataFrame, selected: int, alpha: float) -> tuple[Part, float]:
     """One part over the seeds (``rows``: its claim_parts rows with a ``seed`` column, the selected seed first),
     and the SD of the seeds' effects."""
@@ -149,7 +146,7 @@ def _recipe_part(rows: pd.DataFrame, selected: int, alpha: float) -> tuple[Part,
         z = np.arctanh(np.clip(y, -0.999, 0.999)) if correlation else y
         p_equiv = tost_over_seeds(z, margin) if np.isfinite(margin) else np.nan
     verdict, why = judge(effect, p, sign, alpha, p_equiv, margin)
-    notes = [why, f"seeds {_seeds_text(taken['seed'].astype(int), selected)}"]
+    notes = [why, seed_list([int(s) for s in taken["seed"]], selected)]
     if left_out:
         notes.append(f"left out: {left_out}")
     method = (f"t over {len(taken)} seeds' effects{' on the Fisher-z scale' if correlation else ''}"

@@ -43,7 +43,7 @@ SEED_COLUMNS = ("seed_verdicts", "seeds_agree")
 PLURAL = {"holds": "hold", "weaker": "weaker", "fails": "fail", "not decidable": "not decidable"}
 
 
-def _seeds(seeds: list[int], selected: int | None = None) -> str:
+def seed_list(seeds: list[int], selected: int | None = None) -> str:
     """``seed 3`` or ``seeds 3, 7``, the selected seed marked."""
     names = [f"{s} (selected)" if s == selected else str(s) for s in seeds]
     return f"seed{'s' if len(seeds) > 1 else ''} {', '.join(names)}"
@@ -65,7 +65,7 @@ def agreement(verdicts: Mapping[int, str]) -> str:
     missing = [s for s in seeds if s not in ran]
     if missing:
         others = missing == seeds[1:]  # the selected seed ran and no other did
-        text += " (other seeds: not run)" if others else f" ({_seeds(missing)}: not run)"
+        text += " (other seeds: not run)" if others else f" ({seed_list(missing)}: not run)"
     return text
 
 
@@ -75,7 +75,7 @@ def flip_sentence(verdicts: Mapping[int, str]) -> str:
     ran = {s: v for s, v in verdicts.items() if v != "not run"}
     if len(set(ran.values())) < 2:
         return ""
-    groups = [f"{v} at {_seeds([s for s in ran if ran[s] == v], selected)}" for v in VERDICTS if v in ran.values()]
+    groups = [f"{v} at {seed_list([s for s in ran if ran[s] == v], selected)}" for v in VERDICTS if v in ran.values()]
     return f"The verdict flips between seeds: {'; '.join(groups)}."
 
 
