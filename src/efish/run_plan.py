@@ -282,6 +282,14 @@ class RunPlan:
         return " ".join([self.args, shlex.quote(f"scale.max_episodes={self.cfg.scale.stage_episodes}")])
 
     @property
+    def policy_args(self) -> str:
+        """:attr:`args` for training the policy recipes (homing): with a ``scale.seed_offset`` they train with seed
+        ``seed_offset + 1``, the first of the run's seeds, so that a second run with an offset draws its homing
+        policies anew as well as its foraging seeds; without one, :attr:`args` itself (the recipe's own seed)."""
+        offset = self.cfg.scale.seed_offset
+        return self.args if offset == 0 else " ".join([self.args, shlex.quote(f"train.seed={offset + 1}")])
+
+    @property
     def top_seed_args(self) -> str:
         """:attr:`args` for the top seeds' reruns: capped at ``scale.top_seed_episodes`` episodes per condition
         (:attr:`args` itself where that cap is no lower than ``scale.max_episodes``)."""

@@ -272,3 +272,6 @@ def test_a_seed_offset_trains_a_disjoint_set_of_seeds():
     inputs = [path for figure in plan.figure_panels for path in plan.figure_inputs(figure, Run("other"))]
     assert any("train/seed_3/" in t for t in inputs) and any("train/seed_4/" in t for t in inputs)
     assert not any("train/seed_1/" in t or "train/seed_2/" in t for t in inputs)
+    # the homing policies are drawn anew too (seed 3), while a run without an offset keeps the recipe's own seed
+    assert plan.policy_args == "scale=smoke scale.seed_offset=2 train.seed=3"
+    assert RunPlan.from_config({"scale": "smoke"}, cache=None).policy_args == "scale=smoke"

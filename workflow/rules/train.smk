@@ -33,7 +33,7 @@ rule train_policy:
     benchmark:
         benchmark("train/{policy}")
     params:
-        overrides=PLAN.args,
+        overrides=PLAN.policy_args,
         out=folder_of("final"),
     wildcard_constraints:
         policy="|".join(PLAN.policy_recipes),

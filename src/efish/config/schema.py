@@ -387,8 +387,8 @@ class ScaleConfig:
     name: str = param("laptop", "name of the scale, used in output paths")
     seeds: int = param(4, "foraging seeds trained (seed_offset + 1 .. seed_offset + seeds)", lo=1)
     seed_offset: int = param(0, "the trained seeds start after this one: a second run with offset = seeds draws "
-                             "a disjoint set of seeds of the same recipe (how stable its verdicts are, "
-                             "docs/claims/results.md)", lo=0)
+                             "a disjoint set of seeds of the same recipe, and its homing policies train with seed "
+                             "seed_offset + 1 (how stable its verdicts are, docs/claims/results.md)", lo=0)
     hidden: int = param(64, "network width (train.hidden reads it)", lo=1, hi=8192)
     num_envs: int = param(8, "parallel arenas per rollout (train.num_envs reads it)", lo=1)
     rollout_steps: int = param(400, "steps per foraging rollout (train.rollout_steps reads it)", lo=1)
