@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 
 from efish.config import ConfigError, compose
-from efish.env import parallel_env
 from efish.env.observe import observation_slices
 
 from ..helpers import BIG, actions
@@ -183,9 +182,3 @@ def test_wrong_action_shape_is_rejected():
     env.reset()
     with pytest.raises(ValueError, match="actions must have shape"):
         env.step(np.zeros((2, 4, 3)))
-
-
-def test_parallel_env_passes_the_pettingzoo_api_test():
-    from pettingzoo.test import parallel_api_test
-
-    parallel_api_test(parallel_env(**{"env.episode_steps": 25}), num_cycles=60)

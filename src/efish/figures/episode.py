@@ -25,6 +25,7 @@ import pandas as pd
 
 from ..config.recorded import recorded_conditions
 from ..config.schema import EfishConfig
+from ..drawing import BODY_PT, FRAME_DPI, body_marker, draw_bodies, draw_pellets, draw_walls, frame_size
 from ..io import atomic_path, read_parquet
 from ..units import CM
 from .style import HEATMAP_CMAP, NEUTRAL_COLOUR, PELLET_COLOUR, agent_colour, panel_style
@@ -35,11 +36,6 @@ GIF_MAX_FPS = 50.0
 #: Frames of a clip by default at most (longer episodes draw every k-th step): a GIF of 400 frames of this
 #: size is a few MB, small enough for the Snakemake report.
 MAX_FRAMES = 400
-FRAME_WIDTH_IN = 4.5
-FRAME_DPI = 100
-#: Body marker length in points at size 0 (at size s: times 1 + s); bodies are drawn at a fixed display size
-#: because the true 1 cm radius is a few pixels in a 150 cm arena.
-BODY_PT = 9.0
 FIELD_CELLS = 60  # cells of the field overlay along the arena's longer side
 WRITERS = {".gif": "pillow", ".mp4": "ffmpeg"}
 
@@ -221,32 +217,12 @@ class FieldOverlay:
 
 
 # ----------------------------------------------------------------- drawing
-def body_marker(heading: float):
-    """A fish-shaped marker (pointed snout at +x) turned to ``heading``; display angles equal data angles
-    because the arena is drawn with equal aspect."""
-    from matplotlib.markers import MarkerStyle
-    from matplotlib.path import Path as MplPath
-    from matplotlib.transforms import Affine2D
-
-    outline = MplPath([(1.0, 0.0), (0.35, 0.42), (-0.55, 0.32), (-1.0, 0.0), (-0.55, -0.32), (0.35, -0.42),
-                       (1.0, 0.0)], closed=True)
-    return MarkerStyle(outline, transform=Affine2D().rotate(heading))
-
-
 def draw_arena(fig, ax, ep: Episode, overlay: FieldOverlay | None = None):
     """What stays the same in every frame: walls, axes, title, legend, the field's colour bar. Returns the
     text artist that shows the time (updated per frame)."""
     from matplotlib.lines import Line2D
-    from matplotlib.patches import Rectangle
 
-    w, h = float(ep.cfg.arena.width_cm), float(ep.cfg.arena.height_cm)
-    ax.add_patch(Rectangle((0, 0), w, h, fill=False, lw=1.5, color="black", zorder=5))
-    pad = 0.02 * max(w, h)
-    ax.set_xlim(-pad, w + pad)
-    ax.set_ylim(-pad, h + pad)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x (cm)")
-    ax.set_ylabel("y (cm)")
+    draw_walls(ax, float(ep.cfg.arena.width_cm), float(ep.cfg.arena.height_cm))
     ax.set_title(f"{ep.assay} · {ep.condition} · episode {ep.episode}", loc="left")
     # legend markers at one size: the body sizes are in the labels
     handles = [Line2D([], [], ls="", marker=body_marker(0.0), ms=BODY_PT, color=agent_colour(a), mec="black",
@@ -277,7 +253,7 @@ def draw_frame(ax, ep: Episode, i: int, overlay: FieldOverlay | None = None) -> 
     from matplotlib.patches import Circle
 
     t = int(ep.t[i])
-    xy, heading = ep.xy[i], ep.heading[i]
+    xy = ep.xy[i]
     here = np.isfinite(xy).all(axis=1)
     out: dict[str, list] = {k: [] for k in ("field", "trails", "pellets", "eaten", "home", "flashes", "bites",
                                             "bodies")}
@@ -290,8 +266,7 @@ def draw_frame(ax, ep: Episode, i: int, overlay: FieldOverlay | None = None) -> 
     for k, agent in enumerate(ep.agents):
         out["trails"] += ax.plot(ep.xy[: i + 1, k, 0], ep.xy[: i + 1, k, 1], color=agent_colour(agent), lw=0.6,
                                  alpha=0.4, zorder=1)
-    alive = ep.pellets_at(t)
-    out["pellets"].append(ax.scatter(alive["x_cm"], alive["y_cm"], s=6, color=PELLET_COLOUR, lw=0, zorder=2))
+    out["pellets"].append(draw_pellets(ax, ep.pellets_at(t)[["x_cm", "y_cm"]].to_numpy(float)))
     for _, row in ep.eaten_at(t).iterrows():
         out["eaten"] += ax.plot(row["x_cm"], row["y_cm"], ls="", marker="o", mfc="none", ms=6, mew=1.2,
                                 mec=agent_colour(row["eaten_by"]), zorder=2)
@@ -299,17 +274,7 @@ def draw_frame(ax, ep: Episode, i: int, overlay: FieldOverlay | None = None) -> 
     if target is not None and here[target]:
         out["home"].append(ax.add_patch(Circle(xy[target], ep.cfg.env.homing_radius_cm, fill=False, ls="--",
                                                lw=0.8, color=NEUTRAL_COLOUR, zorder=1)))
-    for k in np.flatnonzero(here):
-        colour, s = agent_colour(ep.agents[k]), ep.size[i, k]
-        if emit[k]:
-            out["flashes"] += ax.plot(*xy[k], ls="", marker="o", mfc=colour, mec=colour, alpha=0.3,
-                                      ms=BODY_PT * (1 + s) * 2, mew=1.5, zorder=3)
-        victim = ep.bite_target[i, k]
-        if ep.bit[i, k] and victim >= 0 and here[victim]:
-            out["bites"] += ax.plot(*np.stack([xy[k], xy[victim]]).T, color="black", lw=1.2, zorder=4)
-            out["bites"] += ax.plot(*xy[victim], ls="", marker="x", color="black", ms=7, mew=1.5, zorder=6)
-        out["bodies"] += ax.plot(*xy[k], ls="", marker=body_marker(heading[k]), ms=BODY_PT * (1 + s),
-                                 color=colour, mec="black", mew=0.5, zorder=5)
+    out.update(draw_bodies(ax, ep.agents, xy, ep.heading[i], ep.size[i], emit, ep.bit[i], ep.bite_target[i]))
     return out
 
 
@@ -370,11 +335,8 @@ def render_clip(ep: Episode, out: Path, every: int | None = None, fps: float | N
         raise ValueError(f"--fps must be positive, got {fps}")
     overlay = FieldOverlay(ep) if field else None
     with panel_style() as plt:
-        w, h = float(ep.cfg.arena.width_cm), float(ep.cfg.arena.height_cm)
-        # the arena keeps its aspect; about 1.3 in hold the title, the x axis and the legend, 0.8 in the
-        # field's colour bar
-        axes_width = 0.85 * FRAME_WIDTH_IN - (0.8 if field else 0.0)
-        fig = plt.figure(figsize=(FRAME_WIDTH_IN, axes_width * min(h / w, 1.5) + 1.3), layout="constrained")
+        fig = plt.figure(figsize=frame_size(float(ep.cfg.arena.width_cm), float(ep.cfg.arena.height_cm), field),
+                         layout="constrained")
         ax = fig.add_subplot()
         clock = draw_arena(fig, ax, ep, overlay)
         fig.canvas.draw()

@@ -17,9 +17,11 @@ import pandas as pd
 from .. import layout
 from ..config.recorded import recorded_conditions, recorded_settings
 from ..config.schema import AnalysisConfig, EfishConfig
+from ..drawing import AGENT_COLOURS as AGENT_COLOURS  # the arena's colours: shared with the live env's render
+from ..drawing import PELLET_COLOUR as PELLET_COLOUR
+from ..drawing import agent_colour as agent_colour
 from .panel import conditions_key, settings_key
 
-AGENT_COLOURS = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#F0E442", "#000000")
 RECEPTOR_COLOURS = {"mormyromast": "#0072B2", "ampullary": "#009E73", "knollenorgan": "#D55E00"}
 SELECTED_COLOUR = "#D55E00"
 NEUTRAL_COLOUR = "#7f7f7f"
@@ -61,11 +63,6 @@ RC_PARAMS = {
     "axes.spines.top": False, "axes.spines.right": False, "legend.frameon": False, "legend.fontsize": 7,
     "xtick.labelsize": 7, "ytick.labelsize": 7, "lines.linewidth": 1.0,
 }
-
-
-def agent_colour(agent: int) -> str:
-    """The colour of agent ``agent`` in every panel."""
-    return AGENT_COLOURS[int(agent) % len(AGENT_COLOURS)]
 
 
 def size_class_colours(n: int) -> list:
@@ -232,10 +229,6 @@ def mean_lines(ax, data: pd.DataFrame, x: str, y: str, hue: str, palette: dict, 
                     label=str(level))
     ax.set_xticks(xs)
     return True
-
-
-#: Food pellets wherever they are drawn (episode clips, scenes): brown, apart from every agent colour.
-PELLET_COLOUR = "#8c564b"
 
 
 # ------------------------------------------- assay conditions: configs and display order
