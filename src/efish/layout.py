@@ -46,6 +46,8 @@ BENCH = "bench"  # the benchmarks' folder: tables under results/<run>/, figures 
 BENCHMARKS = "benchmarks"  # Snakemake's per-job .tsv timings under results/<run>/
 CONTACT_SHEET = "contact_sheet.png"  # under figures/<run>/
 LEARNING = "learning"  # the claims along training: the stages' copies of the layout and the stacked tables
+FINAL_POLICY = "final.pt"  # train/<name>/: the finished training's policy, written last (efish.rl.train)
+TRAINING_METRICS = "metrics.parquet"  # train/<name>/: one row per update, rewritten after each
 
 
 def seed_name(seed: int | str) -> str:
