@@ -94,13 +94,18 @@ SINKS = {"csv": lambda out, rows: CsvLogger(out / CSV_FILE, rows),
          "tensorboard": lambda out, rows: TensorBoardLogger(out / TENSORBOARD_FOLDER, rows)}
 
 
+def installed(package: str) -> bool:
+    """Whether ``package`` can be imported here (without importing it)."""
+    return importlib.util.find_spec(package) is not None
+
+
 def check_loggers(names: list[str]) -> None:
     """One clear error for a sink that cannot run here (unknown, or its package missing): called before training
     starts, so a run never stops at its first update for want of a logger."""
     for name in names:
         if name not in SINKS:
             raise ValueError(f"unknown logger {name!r} in train.loggers: choose any of {', '.join(SINKS)}")
-        if name in EXTRA and importlib.util.find_spec(EXTRA[name]) is None:
+        if name in EXTRA and not installed(EXTRA[name]):
             raise ValueError(f"train.loggers names {name} but the {EXTRA[name]} package is not installed: "
                              f"pip install 'efish[{name}]' (or drop it from train.loggers)")
 
