@@ -13,7 +13,7 @@ from efish.cli import main
 from efish.config import compose
 from efish.layout import Run, seed_name, training_folder
 from efish.rl.train import train
-from efish.watch import Job, duration, job_row
+from efish.watch import Job, duration, job_row, read_metrics
 
 from .helpers import Killed, kill_at
 from .rl.test_train import tiny
@@ -51,7 +51,7 @@ def test_the_eta_is_the_updates_left_at_the_recent_speed(tmp_path):
                             "episode_return": [1.5, float("nan")], "entropy": 0.5, "approx_kl": 0.01,
                             "env_steps_per_s": [40.0, 60.0]})
     metrics.to_parquet(tmp_path / "metrics.parquet")
-    row = job_row(job, metrics, now=0.0)
+    row = job_row(job, read_metrics(job), now=0.0)
     # 2 updates of 100 env steps left at 50 env steps/s; the last update ended no episode: the one before's return
     assert (row["state"], row["update"], row["ETA"], row["return"]) == ("running", "2/4", "4s", "1.500")
     assert job_row(job, None, now=0.0)["state"] == "not started"

@@ -4,7 +4,8 @@ A run named ``<run>`` (the scale, or the scale and a hash of its overrides) keep
 its tables under ``results/<run>/`` and its drawings under ``figures/<run>/``::
 
     results/<run>/
-      train/<seed_N | policy>/        final.pt, metrics.parquet, stage_K.pt (training)
+      train/<seed_N | policy>/        final.pt, metrics.parquet, stage_K.pt (training); metrics.csv, tensorboard/
+                                      (its live logs, efish.rl.loggers)
       selection/seed_N/               episodes, steps, food (held-out patchy episodes)
       analysis/selection/             ranking.parquet, selected_seed.txt
       assays/<assay>/                 steps, episodes, food, conditions (, hidden) .parquet

@@ -83,9 +83,16 @@ def _job_order(name: str) -> tuple:
 
 
 def read_metrics(job: Job) -> pd.DataFrame | None:
-    """The job's metrics so far, or None before its first update."""
+    """The job's metrics so far, with the time they were written in ``.attrs["written"]``; None before its first
+    update (or while a workflow has removed them to rerun the job)."""
     path = job.folder / TRAINING_METRICS
-    return pd.read_parquet(path) if path.exists() else None
+    try:
+        written = path.stat().st_mtime
+        metrics = pd.read_parquet(path)
+    except FileNotFoundError:
+        return None
+    metrics.attrs["written"] = written
+    return metrics
 
 
 def job_row(job: Job, metrics: pd.DataFrame | None, now: float) -> dict:
@@ -100,7 +107,7 @@ def job_row(job: Job, metrics: pd.DataFrame | None, now: float) -> dict:
     total = _total_updates(metrics, job, finished)
     returns = metrics["episode_return"].dropna()  # NaN where no episode ended in an update
     rate = metrics["env_steps_per_s"].tail(RATE_ROWS).mean()
-    age = now - (job.folder / TRAINING_METRICS).stat().st_mtime
+    age = max(0.0, now - metrics.attrs.get("written", now))  # a clock a little behind the file server's
     return {"job": job.name, "state": FINISHED if finished else RUNNING, "update": f"{update}/{_or_unknown(total)}",
             "env steps": f"{int(last['env_steps']):,}",
             "return": f"{returns.iloc[-1]:.3f}" if len(returns) else "-",

@@ -14,6 +14,7 @@ import csv
 import importlib.util
 import math
 import shutil
+from collections.abc import Callable
 from pathlib import Path
 from typing import IO, Protocol
 
@@ -90,8 +91,11 @@ class TensorBoardLogger:
         self.writer.close()
 
 
-SINKS = {"csv": lambda out, rows: CsvLogger(out / CSV_FILE, rows),
-         "tensorboard": lambda out, rows: TensorBoardLogger(out / TENSORBOARD_FOLDER, rows)}
+#: Sink name -> how it opens in a seed's folder, given the rows a resumed run starts from.
+SINKS: dict[str, Callable[[Path, list[dict]], MetricsLogger]] = {
+    "csv": lambda out, rows: CsvLogger(out / CSV_FILE, rows),
+    "tensorboard": lambda out, rows: TensorBoardLogger(out / TENSORBOARD_FOLDER, rows),
+}
 
 
 def installed(package: str) -> bool:
