@@ -102,6 +102,19 @@ def make_env(*overrides: str, num_envs: int = 1, seed: int = 0):
     return VecEnv(compose(list(overrides)), num_envs=num_envs, seed=seed)
 
 
+class Killed(Exception):
+    """Raised by :func:`kill_at`'s callback: training stops as a killed job would, after an update's logs."""
+
+
+def kill_at(update: int):
+    """A ``progress`` callback for :func:`efish.rl.train.train` that stops the run once ``update`` is logged
+    (metrics written, the checkpoint only if that update is a checkpoint's)."""
+    def progress(row: dict, total: int) -> None:
+        if row["update"] == update:
+            raise Killed(f"killed at update {update} of {total}")
+    return progress
+
+
 def actions(env, move=-BIG, turn=0.0, eod=0, bite=0) -> np.ndarray:
     """The same raw action for every agent of every arena: float64[B, N, 4]."""
     a = np.zeros((env.num_envs, env.n, 4))

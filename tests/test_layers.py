@@ -1,7 +1,7 @@
 """The package's layers import one way, and the table-reading layers load neither numba nor torch.
 
 Layers, ground floor first (docs/architecture.md#layout): config <- physics <- sensors <- env
-<- rl <- rollout <- analysis <- claims <- figures <- bench, cli, run_plan. A module may import its
+<- rl <- rollout <- analysis <- claims <- figures <- bench, cli, run_plan, watch. A module may import its
 own layer and the layers below, never one above (imports inside functions
 count too: a lazy import is still a dependency).
 """
@@ -22,7 +22,7 @@ LAYERS = {
     "__init__": 0, "_version": 0, "_numba_cache": 0, "_jit": 0, "io": 0, "config": 0, "layout": 0, "units": 0,
     "drawing": 0,
     "physics": 1, "sensors": 2, "env": 3, "rl": 4, "rollout": 5, "analysis": 6, "claims": 7, "figures": 8,
-    "bench": 9, "cli": 9, "cli_claims": 9, "cli_support": 9, "run_plan": 9, "__main__": 10,
+    "bench": 9, "cli": 9, "cli_claims": 9, "cli_support": 9, "run_plan": 9, "watch": 9, "__main__": 10,
 }
 
 
@@ -132,7 +132,8 @@ def test_every_top_level_module_has_a_layer():
     ["efish.analysis." + p.stem for p in sorted((PACKAGE / "analysis").glob("*.py")) if p.stem != "__init__"],
     ["efish.claims." + p.stem for p in sorted((PACKAGE / "claims").glob("*.py")) if p.stem != "__init__"],
     ["efish.config", "efish.rollout.schema"],
-], ids=["efish", "figures", "analysis", "claims", "config+schema"])
+    ["efish.watch"],  # runs beside the jobs it watches (a cluster's login node): reading tables is all it does
+], ids=["efish", "figures", "analysis", "claims", "config+schema", "watch"])
 def test_table_readers_load_neither_numba_nor_torch(modules):
     code = (f"import importlib, sys\nfor m in {modules!r}: importlib.import_module(m)\n"
             "print(sorted(k for k in ('numba', 'torch') if k in sys.modules))")

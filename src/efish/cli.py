@@ -3,6 +3,8 @@
     efish config [overrides]                  print the resolved config
     efish plan [overrides]                    which effects run, and why
     efish train [overrides] [--out D]         train one seed (checkpoint.pt, metrics.parquet, final.pt)
+    efish watch RUN [--results D] [--interval S] [--once] [--plot F.png]   every training job of a run in a live
+                                              table (update, return, entropy, KL, speed, ETA, state)
     efish assay [overrides] --policy P...     run an assay into steps/episodes/food(/hidden).parquet
     efish schema steps|episodes|food|hidden|conditions   the columns of a rollout table and what they mean
     efish select --episodes F... --out D      rank seeds, write the ranking and the chosen seed
@@ -94,6 +96,16 @@ def _parser() -> argparse.ArgumentParser:
     tr.add_argument("--out", type=Path, help="output folder (default results/{run}/train/seed_{seed})")
     tr.add_argument("--restart", action="store_true", help="discard a checkpoint in --out and start afresh")
     tr.set_defaults(handler=_train, recipe=TRAINING_RECIPE)
+    wa = sub.add_parser("watch", help="a live table of every training job of a run: update, return, entropy, KL, "
+                                      "speed, ETA and state, from their metrics.parquet")
+    wa.add_argument("run", help="the run's folder name under --results (smoke, laptop-453280a3)")
+    wa.add_argument("--results", type=Path, default=Path("results"), help="the results root (default results)")
+    wa.add_argument("--interval", type=float, default=10.0, help="seconds between refreshes (default 10)")
+    wa.add_argument("--once", action="store_true", help="print the table once and exit")
+    wa.add_argument("--plot", type=Path, metavar="F.png",
+                    help="also write return, entropy and KL against env steps, one line per job, to this PNG "
+                         "(rewritten at every refresh)")
+    wa.set_defaults(handler=_watch)  # no overrides: nothing to compose
     asy = sub.add_parser("assay", help="run an assay with a trained policy into Parquet tables")
     asy.add_argument("overrides", nargs="*")
     asy.add_argument("--policy", nargs="+", required=True, metavar="[NAME=]PATH",
@@ -316,6 +328,15 @@ def _train(args, cfg, started) -> None:
         bar.close()
     write_metadata(out, cfg, started, args, compute=df.attrs["compute"])  # device, precision and how it was chosen
     print(f"trained {len(df)} updates into {out}")
+
+
+def _watch(args, cfg, started) -> None:
+    from .watch import watch
+
+    try:
+        watch(Run(args.run, results_root=args.results), args.interval, args.once, args.plot)
+    except KeyboardInterrupt:  # Ctrl-C is how a live table is left: not an error
+        pass
 
 
 def _assay(args, cfg, started) -> None:

@@ -4,7 +4,8 @@ A run named ``<run>`` (the scale, or the scale and a hash of its overrides) keep
 its tables under ``results/<run>/`` and its drawings under ``figures/<run>/``::
 
     results/<run>/
-      train/<seed_N | policy>/        final.pt, metrics.parquet, stage_K.pt (training)
+      train/<seed_N | policy>/        final.pt, metrics.parquet, stage_K.pt (training); metrics.csv, tensorboard/
+                                      (its live logs, efish.rl.loggers)
       selection/seed_N/               episodes, steps, food (held-out patchy episodes)
       analysis/selection/             ranking.parquet, selected_seed.txt
       assays/<assay>/                 steps, episodes, food, conditions (, hidden) .parquet
@@ -46,6 +47,8 @@ BENCH = "bench"  # the benchmarks' folder: tables under results/<run>/, figures 
 BENCHMARKS = "benchmarks"  # Snakemake's per-job .tsv timings under results/<run>/
 CONTACT_SHEET = "contact_sheet.png"  # under figures/<run>/
 LEARNING = "learning"  # the claims along training: the stages' copies of the layout and the stacked tables
+FINAL_POLICY = "final.pt"  # train/<name>/: the finished training's policy, written last (efish.rl.train)
+TRAINING_METRICS = "metrics.parquet"  # train/<name>/: one row per update, rewritten after each
 
 
 def seed_name(seed: int | str) -> str:

@@ -315,6 +315,9 @@ class TrainConfig:
                               "steps reach that fraction of the run's, always checkpointed; [] = none",
                               neutral=True)
     threads: int = param(1, "torch threads", lo=1, hi=256, neutral=True)
+    loggers: list = param(["csv"], "where each update's metrics row also goes as it is made, besides "
+                          "metrics.parquet: csv (metrics.csv), tensorboard (tensorboard/; needs the tensorboard "
+                          "extra); [] = neither", choices=("csv", "tensorboard"), neutral=True)
     precision: str = param("auto", "arithmetic of the update's forward passes: fp32, bf16 autocast, or auto (time "
                            "the training GEMM in both at start, take the faster; recorded in provenance.json)",
                            choices=("auto", "fp32", "bf16"))
@@ -323,6 +326,11 @@ class TrainConfig:
     device: str = param("cpu", "where the networks and the PPO update run (cuda: a GPU node); a resumed run may "
                         "switch", choices=("cpu", "cuda"), neutral=True)
     seed: int = param(1, "training seed", lo=0)
+
+    def total_updates(self) -> int:
+        """The updates a run makes: ``total_steps`` in whole rollouts of ``rollout_steps`` x ``num_envs``, at
+        least one."""
+        return max(1, self.total_steps // (self.rollout_steps * self.num_envs))
 
 
 # ----------------------------------------------------------------------- assay
@@ -603,9 +611,12 @@ def validate(obj: Any, path: str = "") -> None:
             validate(value, key + ".")
             continue
         meta = f.metadata
-        if meta.get("choices") is not None and value not in meta["choices"]:
+        # a list field with choices (train.loggers) picks any of them: each item is checked
+        is_list = isinstance(value, (list, tuple))
+        items = value if is_list else [value]
+        if meta.get("choices") is not None and any(item not in meta["choices"] for item in items):
             allowed = ", ".join(str(c) for c in meta["choices"])
-            raise ConfigError(f"{key}={value!r} is not allowed: choose one of {allowed}")
+            raise ConfigError(f"{key}={value!r} is not allowed: choose {'any' if is_list else 'one'} of {allowed}")
         lo, hi = meta.get("lo"), meta.get("hi")
         if (lo is not None and value < lo) or (hi is not None and value > hi):
             lo_s = "-inf" if lo is None else f"{lo:g}"

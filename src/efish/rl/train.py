@@ -2,7 +2,9 @@
 docs/architecture.md#training).
 
 Readable top to bottom: collect a rollout with the current policy, compute
-advantages, run the PPO epochs, log one metrics row, checkpoint. A checkpoint
+advantages, run the PPO epochs, log one metrics row (metrics.parquet, rewritten
+atomically every update, and the live logs of ``train.loggers``,
+:mod:`efish.rl.loggers`), checkpoint every ``train.checkpoint_every`` updates. A checkpoint
 holds the networks, optimisers, value normaliser, every RNG state, the
 environment state and the precision the run computes in, so a resumed run ends
 with the same weights as an uninterrupted one. The networks and the update run
@@ -35,18 +37,19 @@ from ..config.schema import (
 )
 from ..env.vec_env import VecEnv
 from ..io import atomic_path, remove_partial_writes
-from ..layout import stage_file
+from ..layout import FINAL_POLICY, TRAINING_METRICS, stage_file
 from ..physics.geometry import conspecific_slots
 from .advantages import gae
 from .compute import Compute, resolve_compute, resolve_device
+from .loggers import Loggers, check_loggers
 from .mappo import Rollout, ppo_update
 from .networks import Actor, Critic
 from .value_norm import ValueNormalizer
 
 CHECKPOINT = "checkpoint.pt"
 LOG = logging.getLogger(__name__)
-FINAL = "final.pt"  # the finished run: what the pipeline declares as the training output
-METRICS = "metrics.parquet"
+FINAL = FINAL_POLICY  # the finished run: what the pipeline declares as the training output
+METRICS = TRAINING_METRICS
 STAGE_COPIES = "stage_copies"  # checkpoint key: {k: stage file contents} of the stages the run has passed
 CPU = torch.device("cpu")
 
@@ -156,7 +159,8 @@ def collect(cfg: EfishConfig, env: VecEnv, learner: Learner, carry: dict, genera
 
 def train(cfg: EfishConfig, out_dir: str | Path, progress=None, restart: bool = False) -> pd.DataFrame:
     """Train one seed into ``out_dir`` (checkpoint.pt, metrics.parquet, and final.pt at the end; stage_<k>.pt on
-    the way for ``train.keep_stages``, see :func:`stages_to_write`).
+    the way for ``train.keep_stages``, see :func:`stages_to_write`; metrics.csv and tensorboard/ for
+    ``train.loggers``).
 
     Resumes from a checkpoint there only when it was written under the same
     config (apart from the schema's result-neutral keys: threads, device,
@@ -172,6 +176,7 @@ def train(cfg: EfishConfig, out_dir: str | Path, progress=None, restart: bool = 
     t_cfg = cfg.train
     torch.set_num_threads(t_cfg.threads)
     resolve_device(t_cfg.device)  # a device this machine lacks fails here, before anything is touched
+    check_loggers(t_cfg.loggers)  # so does a logger whose package is missing
     env = VecEnv(cfg, num_envs=t_cfg.num_envs, seed=t_cfg.seed)
     obs = env.reset()  # bad env settings fail here, before anything is written
     remove_partial_writes(out)  # temporaries of a killed run
@@ -188,7 +193,7 @@ def train(cfg: EfishConfig, out_dir: str | Path, progress=None, restart: bool = 
     carry = initial_carry(obs, t_cfg.hidden, compute.device)
     generator = torch.Generator().manual_seed(t_cfg.seed)
     steps_per_update = t_cfg.rollout_steps * t_cfg.num_envs
-    total_updates = max(1, t_cfg.total_steps // steps_per_update)
+    total_updates = t_cfg.total_updates()
     plan = stage_plan(t_cfg.keep_stages, total_updates, steps_per_update)
     rows, update = [], 0
     if state is not None:
@@ -200,27 +205,31 @@ def train(cfg: EfishConfig, out_dir: str | Path, progress=None, restart: bool = 
     passed = stages_passed(out, plan, state)
     stage_at = {stage["update"] for stage in plan}
     start = time.perf_counter()
-    while update < total_updates:
-        t0 = time.perf_counter()
-        ro, episode = collect(cfg, env, learner, carry, generator)
-        losses = ppo_update(t_cfg, learner.actor, learner.critic, learner.actor_opt, learner.critic_opt,
-                            learner.value_norm, ro, generator, compute)
-        update += 1
-        seconds = time.perf_counter() - t0
-        rows.append({"update": update, "env_steps": update * steps_per_update, "wall_s": time.perf_counter() - start,
-                     **episode, **losses, "env_steps_per_s": steps_per_update / seconds})
-        if progress:
-            progress(rows[-1], total_updates)
-        # a stage's update is always checkpointed, so a killed run resumes at or before it and never skips it
-        if update % t_cfg.checkpoint_every == 0 or update == total_updates or update in stage_at:
-            saved = checkpoint_state(cfg, compute, learner, env, carry, generator, update, rows)
-            due = [stage for stage in todo if stage["update"] == update]
-            # a copy: ``saved`` shares memory with the live networks, and ``passed`` outlives this update
-            passed.update({stage["k"]: stage_contents(copy.deepcopy(saved), stage) for stage in due})
-            write_checkpoint(out / CHECKPOINT, {**saved, STAGE_COPIES: passed})
+    with Loggers(t_cfg.loggers, out, rows) as loggers:  # opened after the restore: they start from its rows
+        while update < total_updates:
+            t0 = time.perf_counter()
+            ro, episode = collect(cfg, env, learner, carry, generator)
+            losses = ppo_update(t_cfg, learner.actor, learner.critic, learner.actor_opt, learner.critic_opt,
+                                learner.value_norm, ro, generator, compute)
+            update += 1
+            seconds = time.perf_counter() - t0
+            rows.append({"update": update, "total_updates": total_updates, "env_steps": update * steps_per_update,
+                         "wall_s": time.perf_counter() - start, **episode, **losses,
+                         "env_steps_per_s": steps_per_update / seconds})
+            loggers.log(rows[-1])
+            # every update, atomically: a reader (efish watch) sees the run as it goes and never a torn table
             write_metrics(out / METRICS, rows)
-            for stage in due:
-                write_stage(out / stage_file(stage["k"]), passed[stage["k"]])
+            if progress:
+                progress(rows[-1], total_updates)
+            # a stage's update is always checkpointed, so a killed run resumes at or before it and never skips it
+            if update % t_cfg.checkpoint_every == 0 or update == total_updates or update in stage_at:
+                saved = checkpoint_state(cfg, compute, learner, env, carry, generator, update, rows)
+                due = [stage for stage in todo if stage["update"] == update]
+                # a copy: ``saved`` shares memory with the live networks, and ``passed`` outlives this update
+                passed.update({stage["k"]: stage_contents(copy.deepcopy(saved), stage) for stage in due})
+                write_checkpoint(out / CHECKPOINT, {**saved, STAGE_COPIES: passed})
+                for stage in due:
+                    write_stage(out / stage_file(stage["k"]), passed[stage["k"]])
     # Written at the end, atomically: a killed job never leaves a final.pt, so the workflow reruns it and the
     # rerun resumes from checkpoint.pt; a finished run rerun with its config writes both outputs again.
     write_metrics(out / METRICS, rows)
