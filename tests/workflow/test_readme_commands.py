@@ -80,6 +80,9 @@ def check_for(words: list[str]) -> Check | None:
         return Check(elsewhere="a web server that runs until stopped: CI builds the same site with mkdocs build")
     if program == "workflow/slurm/local-cluster.sh" or any("profiles/slurm" in w for w in option(words, "--profile")):
         return Check(elsewhere="needs a SLURM cluster and the slurm extra: tests/slurm runs it on a one-node cluster")
+    if program in ("docker", "apptainer"):
+        return Check(elsewhere="builds or pushes the container image, which needs a container runtime these machines "
+                               "lack: tests/test_container.py checks the recipes")
     if words[:3] == ["efish", "bench", "budget"]:
         return Check(elsewhere="trains for the minutes it is given: tests/bench/test_budget_bench.py runs it at a "
                                "fraction of a minute")
