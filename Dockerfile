@@ -10,10 +10,10 @@ ENV PIP_DISABLE_PIP_VERSION_CHECK=1 \
 
 # Only what the package is built from (pyproject.toml's readme, the sources, the config tree it ships), so
 # results/ and figures/ never enter the image; .dockerignore keeps them out of the build context too.
-COPY pyproject.toml README.md /tmp/efish/
-COPY src /tmp/efish/src
-COPY config /tmp/efish/config
-COPY container/install.sh /tmp/efish/container/install.sh
-RUN sh /tmp/efish/container/install.sh /tmp/efish && rm -rf /tmp/efish
+COPY pyproject.toml README.md /opt/efish-src/
+COPY src /opt/efish-src/src
+COPY config /opt/efish-src/config
+COPY container/install.sh /opt/efish-src/container/install.sh
+RUN sh /opt/efish-src/container/install.sh /opt/efish-src && rm -rf /opt/efish-src
 
 CMD ["efish", "--help"]

@@ -2,8 +2,9 @@
 
 No container daemon runs on these machines, so nothing is built here: small parsers read the instructions the
 recipes use, and :func:`problems` compares what they install with the sources: Python of environment.yml, torch of
-pyproject.toml from PyTorch's CPU index (no CUDA), the extras of the README's first install command, and no other
-version restated. The Snakefile's container directive must name the image the docs build, and the slurm-apptainer
+pyproject.toml from PyTorch's CPU index (no CUDA), the extras of the README's first install command, no other
+version restated, and both images copying the same files, every one the package is built from (and .dockerignore
+letting them in). The Snakefile's container directive must name the image the docs build, and the slurm-apptainer
 profile must be the slurm profile plus the container settings. Each check is shown to fail on a recipe changed
 the way it guards against (a torch pin, a Python, an extra, a CUDA index).
 """
@@ -29,7 +30,8 @@ DOCKER_INSTRUCTIONS = {"FROM", "ARG", "ENV", "COPY", "RUN", "WORKDIR", "LABEL", 
 APPTAINER_SECTIONS = {"setup", "files", "environment", "post", "runscript", "startscript", "test", "labels", "help",
                       "arguments"}
 CPU_INDEX = "https://download.pytorch.org/whl/cpu"
-RECIPES = {"dockerfile": "Dockerfile", "definition": "container/efish.def", "install": "container/install.sh",
+RECIPES = {"dockerfile": "Dockerfile", "dockerignore": ".dockerignore", "definition": "container/efish.def",
+           "install": "container/install.sh",
            "pyproject": "pyproject.toml", "environment": "environment.yml", "readme": "README.md",
            "snakefile": "Snakefile", "docs": "docs/getting-started.md"}
 
@@ -149,6 +151,17 @@ def torch_pin(pyproject: str) -> str:
     return m[1]
 
 
+def build_inputs(pyproject: str) -> set[str]:
+    """The top-level paths the package is built from: pyproject.toml, its readme, the wheel's package folders and
+    its force-included trees (the config), plus the install recipe the images run."""
+    import tomllib
+
+    data = tomllib.loads(pyproject)
+    wheel = data["tool"]["hatch"]["build"]["targets"]["wheel"]
+    paths = [data["project"]["readme"], *wheel["packages"], *wheel.get("force-include", {})]
+    return {"pyproject.toml", "container/install.sh", *(path.split("/")[0] for path in paths)}
+
+
 def environment_python(environment: str) -> str:
     """environment.yml's Python (``python=3.11`` -> ``3.11``)."""
     deps = [d for d in yaml.safe_load(environment)["dependencies"] if isinstance(d, str) and d.startswith("python")]
@@ -175,28 +188,43 @@ def documented_sif(page: str) -> str:
 # ------------------------------------------------------------------ the comparison
 
 
-def problems(texts: dict[str, str]) -> list[str]:
-    """Every way the recipes in ``texts`` (keys of :data:`RECIPES`) differ from what the sources pin; none: agree."""
-    found = []
-    python = environment_python(texts["environment"])
-    steps = dockerfile(texts["dockerfile"])
-    header, sections = definition(texts["definition"])
-    for name, image in (("Dockerfile", steps[0][1]), ("efish.def", header["from"])):
+def python_problems(texts: dict[str, str]) -> list[str]:
+    """Both images build on the official python image of environment.yml's Python."""
+    python, found = environment_python(texts["environment"]), []
+    for name, image in (("Dockerfile", dockerfile(texts["dockerfile"])[0][1]),
+                        ("efish.def", definition(texts["definition"])[0]["from"])):
         if python_of_image(image) is None:
             found.append(f"{name} builds on {image}, not on an official python image")
         elif python_of_image(image) != python:
             found.append(f"{name} builds on Python {python_of_image(image)}, environment.yml has {python}")
-    installer = "container/install.sh"
-    docker_runs = [args for kind, args in steps if kind == "RUN"]
-    if not any(installer in run for run in docker_runs) or not any(installer in line for line in sections["post"]):
+    return found
+
+
+def copy_problems(texts: dict[str, str]) -> list[str]:
+    """Both images copy the same files, every one the package is built from, and run install.sh on them."""
+    steps, (_, sections) = dockerfile(texts["dockerfile"]), definition(texts["definition"])
+    found, installer = [], "container/install.sh"
+    if not any(installer in args for kind, args in steps if kind == "RUN") or not any(
+            installer in line for line in sections.get("post", [])):
         found.append(f"the Dockerfile and efish.def do not both run {installer}")
     copied = {w for kind, args in steps if kind == "COPY" for w in args.split()[:-1]}
     files = {line.split()[0] for line in sections.get("files", [])}
     if copied != files:
         found.append(f"the Dockerfile copies {sorted(copied)}, efish.def {sorted(files)}")
-    installs = pip_installs(texts["install"])
-    torch = [w for words in installs for w in words if w.startswith("torch")]
-    pin = torch_pin(texts["pyproject"])
+    if missing := build_inputs(texts["pyproject"]) - copied:
+        found.append(f"the images lack what the package is built from: {sorted(missing)}")
+    # .dockerignore leaves everything out (results/ can hold gigabytes) but what it lets in with "!"
+    let_in = {line[1:] for line in texts["dockerignore"].splitlines() if line.startswith("!")}
+    if left_out := copied - let_in:
+        found.append(f".dockerignore leaves out what the Dockerfile copies: {sorted(left_out)}")
+    return found
+
+
+def pin_problems(texts: dict[str, str]) -> list[str]:
+    """install.sh installs pyproject's torch pin from the CPU index, the checkout with the README's extras, and
+    restates no other version."""
+    installs, found = pip_installs(texts["install"]), []
+    torch, pin = [w for words in installs for w in words if w.startswith("torch")], torch_pin(texts["pyproject"])
     if torch != [f"torch=={pin}"]:
         found.append(f"install.sh installs {torch}, pyproject pins torch=={pin}")
     for words in installs:
@@ -209,16 +237,30 @@ def problems(texts: dict[str, str]) -> list[str]:
     wanted = extras(readme_install(texts["readme"]))
     if len(package) != 1 or extras(package[0].replace("$1", ".")) != wanted:
         found.append(f"install.sh installs the checkout as {package}, the README with extras {sorted(wanted)}")
-    # what the recipes execute (not their comments, nor the .def's help text, which say "no CUDA")
+    return found
+
+
+def cuda_problems(texts: dict[str, str]) -> list[str]:
+    """Nothing the recipes execute names CUDA (their comments and the .def's help text may: they say "no CUDA")."""
+    steps, (header, sections) = dockerfile(texts["dockerfile"]), definition(texts["definition"])
     executed = [args for _, args in steps] + list(header.values()) + [
         line for name in ("files", "post", "environment", "runscript") for line in sections.get(name, [])] + [
         line for line in texts["install"].splitlines() if not line.lstrip().startswith("#")]
-    if cuda := re.findall(r"whl/cu\d+|nvidia|cuda", "\n".join(executed), re.I):
-        found.append(f"the recipes name CUDA: {sorted(set(cuda))}")
+    cuda = re.findall(r"whl/cu\d+|nvidia|cuda", "\n".join(executed), re.I)
+    return [f"the recipes name CUDA: {sorted(set(cuda))}"] if cuda else []
+
+
+def image_problems(texts: dict[str, str]) -> list[str]:
+    """The Snakefile's container directive names the image the docs build."""
     image, documented = container_image(texts["snakefile"]), documented_sif(texts["docs"])
-    if image != documented:
-        found.append(f"the Snakefile's container directive names {image}, the docs build {documented}")
-    return found
+    return [] if image == documented else [f"the Snakefile's container directive names {image}, the docs build "
+                                           f"{documented}"]
+
+
+def problems(texts: dict[str, str]) -> list[str]:
+    """Every way the recipes in ``texts`` (keys of :data:`RECIPES`) differ from what the sources pin; none: agree."""
+    return [p for check in (python_problems, copy_problems, pin_problems, cuda_problems, image_problems)
+            for p in check(texts)]
 
 
 @pytest.fixture(scope="module")
@@ -244,7 +286,10 @@ def test_the_recipes_install_what_the_sources_pin(texts):
     ("dockerfile", "FROM python:3.11-slim", "FROM nvidia/cuda:12.8.0-runtime-ubuntu24.04",
      "the recipes name CUDA: ['cuda', 'nvidia']"),
     ("definition", "From: python:3.11-slim", "From: ubuntu:24.04", "efish.def builds on ubuntu:24.04, not on an"),
-    ("definition", "    src /tmp/efish/src\n", "", "the Dockerfile copies"),
+    ("definition", "    src /opt/efish-src/src\n", "", "the Dockerfile copies"),
+    ("dockerignore", "!config\n", "", ".dockerignore leaves out what the Dockerfile copies: ['config']"),
+    ("pyproject", '"config" = "efish/_config"', '"config" = "efish/_config"\n"workflow" = "efish/_workflow"',
+     "the images lack what the package is built from: ['workflow']"),
     ("snakefile", '"efish.sif")', '"efish-0.1.0.sif")', "the Snakefile's container directive names efish-0.1.0.sif"),
 ])
 def test_each_check_catches_the_change_it_guards_against(texts, key, old, new, expected):
