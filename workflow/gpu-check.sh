@@ -2,7 +2,7 @@
 # The GPU check: what a person with a CUDA GPU runs from the root of a checkout, in under about 10 minutes:
 #   workflow/gpu-check.sh
 # 1. installs efish and its test extra if they are not importable, keeping a CUDA build of torch that is already
-#    installed (pip would otherwise reinstall pyproject's torch==2.13.0 over it);
+#    installed (of another version than pyproject's pin, pip would otherwise replace it with torch==2.13.0);
 # 2. runs the tests marked gpu (training on the GPU matches the CPU from the same seed);
 # 3. times training at the paper's width on the CPU and on the GPU (efish bench train at the paper scale, each
 #    bounded by EFISH_GPU_CHECK_BENCH_S seconds, default 240) and prints them side by side, naming both.
