@@ -240,6 +240,9 @@ def _bench_parsers(b: argparse.ArgumentParser) -> None:
     bt.add_argument("overrides", nargs="*")
     bt.add_argument("--json", action="store_true", help="print JSON instead of a table")
     bt.add_argument("--hidden", type=int, nargs="+", help="widths to time (default bench.train_hidden)")
+    bt.add_argument("--device", choices=("cpu", "cuda", "auto"),
+                    help="where the GEMMs, the update and the rollout's networks run (default train.device; auto: "
+                         "cuda where torch sees a GPU)")
     bt.set_defaults(handler=_bench_train, recipe=TRAINING_RECIPE)
     bb = bsub.add_parser("budget", help="at fixed training time: a wider network, more env steps or more seeds")
     bb.add_argument("overrides", nargs="*")
@@ -537,7 +540,10 @@ def _bench_env(args, cfg, started) -> None:
 
 def _bench_train(args, cfg, started) -> None:
     from .bench.train import bench_train, format_train
+    from .rl.compute import pick_device
 
+    if args.device:
+        cfg = dataclasses.replace(cfg, train=dataclasses.replace(cfg.train, device=pick_device(args.device)))
     rows = bench_train(_with_bench(cfg, train_hidden=args.hidden), progress=lambda line: _stderr(f"bench train: {line}"))
     print(json.dumps(rows, indent=2) if args.json else format_train(rows))
 

@@ -19,7 +19,7 @@ def test_bench_train_reports_positive_rates_and_an_mfu_below_one():
     assert [r["precision"] for r in rows] == ["fp32", "bf16"]
     for r in rows:
         assert r["update_samples_per_s"] > 0 and r["rollout_env_steps_per_s"] > 0 and 0 < r["mfu"] < 1
-        assert r["note"] == "" and r["cpu_capability"] and r["cpu"]
+        assert r["note"] == "" and r["cpu_capability"] and r["cpu"] and "gpu" not in r  # train.device=cpu
 
 
 def test_bench_times_the_configured_pass_shape():
@@ -49,7 +49,7 @@ def slow_bf16(monkeypatch):
     from efish.bench import train
     from efish.rl.compute import Compute
 
-    monkeypatch.setattr(train, "gemm_flops", lambda dtype: 47e9 if dtype == torch.float32 else 0.9e9)
+    monkeypatch.setattr(train, "gemm_flops", lambda dtype, device: 47e9 if dtype == torch.float32 else 0.9e9)
     monkeypatch.setattr(train, "choose_precision", lambda t, shape, device: Compute(
         device, "fp32", "auto", shape, {"fp32": 47e9, "bf16": 0.9e9}))
     timed = []
@@ -99,3 +99,45 @@ def test_efish_bench_train_prints_its_progress_and_the_cpu(slow_bf16, capsys):
     assert "bench train: width 8 bf16: skipped" in err and "CPU: " in out and "skipped: bf16" in out
     assert main(["bench", "train", *TINY, "--hidden", "0"]) == 2
     assert capsys.readouterr().err.strip() == "efish: error: bench train needs at least one width, each >= 1; got [0]"
+
+
+@pytest.mark.parametrize("argv, cuda_seen, device", [
+    ([], False, "cpu"), (["--device", "auto"], False, "cpu"), (["--device", "auto"], True, "cuda"),
+    (["--device", "cuda"], False, "cuda"), (["--device", "cpu"], True, "cpu"),
+])
+def test_the_device_flag_sets_train_device_auto_taking_a_gpu_where_torch_sees_one(monkeypatch, argv, cuda_seen, device):
+    from efish import cli
+    from efish.bench import train
+
+    seen = []
+    monkeypatch.setattr(torch.cuda, "is_available", lambda: cuda_seen)
+    monkeypatch.setattr(train, "bench_train", lambda cfg, progress: seen.append(cfg.train.device) or [])
+    monkeypatch.setattr(train, "format_train", lambda rows: "")
+    assert cli.main(["bench", "train", *TINY, *argv]) == 0 and seen == [device]
+
+
+
+def test_a_device_other_than_auto_cpu_or_cuda_is_one_line():
+    from efish.rl.compute import pick_device
+
+    with pytest.raises(ValueError, match=r"^device must be auto, cpu or cuda, not 'tpu'$"):
+        pick_device("tpu")
+
+
+@pytest.mark.skipif(torch.cuda.is_available(), reason="this machine has a CUDA device")
+def test_bench_on_cuda_without_a_cuda_device_is_one_line(capsys):
+    from efish import cli
+
+    assert cli.main(["bench", "train", *TINY, "--device", "cuda"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("efish: error: train.device=cuda, but this torch") and "no CUDA device" in err
+    assert "\n" not in err
+
+
+def test_a_gpu_row_names_the_gpu_and_a_cpu_row_has_no_gpu_key():
+    from efish.bench.timing import gpu, machine_line
+
+    assert gpu(torch.device("cpu")) == {}
+    cpu = {"cpu": "AMD EPYC", "cpu_capability": "AVX2"}
+    assert machine_line(cpu) == "CPU: AMD EPYC (torch CPU capability AVX2)"
+    assert machine_line({**cpu, "gpu": "NVIDIA H100"}) == "CPU: AMD EPYC (torch CPU capability AVX2); GPU: NVIDIA H100"

@@ -78,8 +78,14 @@ def check_for(words: list[str]) -> Check | None:
         return Check(elsewhere="CI's own command (the README's test command) runs it with the test and docs extras")
     if words == ["mkdocs", "serve"]:
         return Check(elsewhere="a web server that runs until stopped: CI builds the same site with mkdocs build")
+    if option(words, "--profile") == ["workflow/profiles/slurm-apptainer"]:
+        return Check(elsewhere="needs a SLURM cluster, apptainer and the image: tests/test_container.py plans it as a "
+                               "dry run")
     if program == "workflow/slurm/local-cluster.sh" or any("profiles/slurm" in w for w in option(words, "--profile")):
         return Check(elsewhere="needs a SLURM cluster and the slurm extra: tests/slurm runs it on a one-node cluster")
+    if program in ("docker", "apptainer"):
+        return Check(elsewhere="builds or pushes the container image, which needs a container runtime these machines "
+                               "lack: tests/test_container.py checks the recipes")
     if words[:3] == ["efish", "bench", "budget"]:
         return Check(elsewhere="trains for the minutes it is given: tests/bench/test_budget_bench.py runs it at a "
                                "fraction of a minute")
@@ -127,6 +133,7 @@ def test_the_checks_run_what_can_run_and_name_where_the_rest_is_checked():
     assert check_for(smoke).nothing_to_do and not check_for([*smoke, "--report", "r.html"]).nothing_to_do
     assert check_for(["snakemake", "--profile", "workflow/profiles/default"]).argv[-1] == "--dry-run"
     assert "tests/slurm" in check_for(["snakemake", "--profile", "workflow/profiles/slurm"]).elsewhere
+    assert "test_container" in check_for(["snakemake", "--profile", "workflow/profiles/slurm-apptainer"]).elsewhere
     assert check_for(["make", "all"]) is None
 
 

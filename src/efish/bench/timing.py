@@ -5,7 +5,10 @@ from __future__ import annotations
 import platform
 import time
 from pathlib import Path
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
+
+if TYPE_CHECKING:
+    import torch
 
 
 def cpu_name() -> str:
@@ -35,9 +38,19 @@ def machine() -> dict[str, str]:
     return {"cpu": cpu_name(), "cpu_capability": cpu_capability()}
 
 
+def gpu(device: torch.device) -> dict[str, str]:
+    """``{"gpu": <model name>}`` when ``device`` is a CUDA device, else nothing: a row timed on a GPU
+    names it beside the CPU, and a CPU row keeps the keys it always had."""
+    import torch
+
+    return {"gpu": torch.cuda.get_device_name(device)} if device.type == "cuda" else {}
+
+
 def machine_line(info: dict) -> str:
-    """One line naming the machine of :func:`machine`'s ``info``, printed above a benchmark's table."""
-    return f"CPU: {info.get('cpu', '?')} (torch CPU capability {info.get('cpu_capability', '?')})"
+    """One line naming the machine of :func:`machine`'s ``info`` (and the GPU of :func:`gpu`, when there is one),
+    printed above a benchmark's table."""
+    line = f"CPU: {info.get('cpu', '?')} (torch CPU capability {info.get('cpu_capability', '?')})"
+    return f"{line}; GPU: {info['gpu']}" if info.get("gpu") else line
 
 
 def best_time(fn: Callable[[], object], repeats: int, warmup: bool = True) -> float:

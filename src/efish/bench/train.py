@@ -25,29 +25,35 @@ import torch
 
 from ..config.schema import EfishConfig
 from ..env.observe import observation_size
-from ..rl.compute import DTYPES, Compute, choose_precision, resolve_device
+from ..rl.compute import DTYPES, Compute, choose_precision, resolve_device, synchronizer
 from ..rl.compute import pass_sequences as timed_sequences  # the pass shape the update runs, hence times
 from ..rl.mappo import Rollout, ppo_update
 from ..rl.networks import Actor, Critic
 from ..rl.value_norm import ValueNormalizer
-from .timing import best_time, machine, machine_line
+from .timing import best_time, gpu, machine, machine_line
+
+CPU = torch.device("cpu")
 
 
-def gemm_flops(dtype: torch.dtype, sizes: tuple[int, ...] = (512, 1024, 2048), repeats: int = 10,
-               size_seconds: float = 1.0, max_call_seconds: float = 1.0) -> float:
-    """Peak FLOP/s of square matrix products at ``dtype``: the best over sizes and up to ``repeats`` calls each.
+def gemm_flops(dtype: torch.dtype, device: torch.device = CPU,
+               sizes: tuple[int, ...] = (512, 1024, 2048), repeats: int = 10, size_seconds: float = 1.0,
+               max_call_seconds: float = 1.0) -> float:
+    """Peak FLOP/s of square matrix products at ``dtype`` on ``device``: the best over sizes and up to ``repeats``
+    calls each (each call waited for, so a GPU's asynchronous launch is not timed as the product).
 
     Bounded in time whatever the speed: a size's repeats stop after about ``size_seconds``, and a larger size is
     not tried when the last one's time predicts (n cubed) a product longer than ``max_call_seconds``. So a slow
     precision (bf16 at ~1 GFLOP/s without AVX-512) costs a second or two, not minutes."""
     best = 0.0
+    sync = synchronizer(device)
     for i, n in enumerate(sizes):
-        a, b = torch.randn(n, n).to(dtype), torch.randn(n, n).to(dtype)
+        a, b = torch.randn(n, n).to(device, dtype), torch.randn(n, n).to(device, dtype)
         t0 = time.perf_counter()
         a @ b  # the warm-up call, which also says what one call costs
+        sync()
         first = time.perf_counter() - t0
         calls = max(1, min(repeats, int(size_seconds / max(first, 1e-9))))
-        seconds = min(first, best_time(lambda a=a, b=b: a @ b, calls, warmup=False))
+        seconds = min(first, best_time(lambda a=a, b=b: (a @ b, sync()), calls, warmup=False))
         best = max(best, 2 * n ** 3 / seconds)
         if i + 1 < len(sizes) and seconds * (sizes[i + 1] / n) ** 3 > max_call_seconds:
             break
@@ -123,19 +129,20 @@ def bench_train(cfg: EfishConfig, hiddens: tuple[int, ...] | None = None, rollou
     ``hiddens`` defaults to ``bench.train_hidden``. Every GEMM is timed first; a precision
     :func:`skipped_precisions` names (``bench.train_skip_below``) keeps its GEMM rates, None for the update's
     and end-to-end rates, and the reason in ``note``. ``progress`` receives a line as each step starts or ends,
-    so a long run is not silent; every row has the CPU's ``cpu`` and ``cpu_capability``."""
+    so a long run is not silent; every row has the CPU's ``cpu`` and ``cpu_capability``, and on a GPU
+    (``train.device=cuda``, ``--device``) its ``gpu``, where the GEMMs, the update and the rollout's networks run."""
     hiddens = tuple(cfg.bench.train_hidden if hiddens is None else hiddens)
     if not hiddens or min(hiddens) < 1:
         raise ValueError(f"bench train needs at least one width, each >= 1; got {list(hiddens)}")
     say = progress or (lambda line: None)
     torch.set_num_threads(cfg.train.threads)
     device = resolve_device(cfg.train.device)
-    info = machine()
+    info = {**machine(), **gpu(device)}
     say(f"{machine_line(info)}; {cfg.train.threads} torch thread(s), update on {device}")
     obs_dim, n_agents = observation_size(cfg), cfg.env.n_agents
     peaks = {}
     for precision, dtype in DTYPES.items():
-        peaks[precision] = gemm_flops(dtype)
+        peaks[precision] = gemm_flops(dtype, device)
         say(f"peak GEMM {precision}: {peaks[precision] / 1e9:.3g} GFLOP/s")
     autos = {}  # every width's training-shape GEMMs before any update: cheap, and they decide what is timed
     for hidden in hiddens:

@@ -19,6 +19,7 @@ order), so a checkpoint's generator state resumes on any device.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import torch
@@ -64,6 +65,22 @@ def resolve_device(name: str) -> torch.device:
     return torch.device(name)
 
 
+def pick_device(name: str) -> str:
+    """A device choice as a ``train.device`` value: ``auto`` is cuda where torch sees a GPU, else cpu; cpu and cuda
+    are kept (a cuda this machine lacks fails later, in :func:`resolve_device`, with its one-line reason)."""
+    if name not in ("auto", "cpu", "cuda"):
+        raise ValueError(f"device must be auto, cpu or cuda, not {name!r}")
+    if name == "auto":
+        return "cuda" if torch.cuda.is_available() else "cpu"
+    return name
+
+
+def synchronizer(device: torch.device) -> Callable[[], None]:
+    """A call that waits for ``device``'s queued work: CUDA runs kernels asynchronously, so a timing that stops the
+    clock before this measures the launch, not the work. A no-op on the CPU."""
+    return torch.cuda.synchronize if device.type == "cuda" else (lambda: None)
+
+
 def pass_sequences(cfg: EfishConfig) -> int:
     """Sequences in one forward/backward pass of the update: a minibatch of chunks (arenas x agents x
     rollout/chunk / minibatches), cut to ``train.micro_sequences``."""
@@ -80,7 +97,7 @@ def gemm_rates(shape: tuple[int, int, int], device: torch.device, precisions=("f
     gen = torch.Generator().manual_seed(0)
     pairs = {p: (torch.randn(m, k, generator=gen).to(device, DTYPES[p]),
                  torch.randn(k, n, generator=gen).to(device, DTYPES[p])) for p in precisions}
-    sync = torch.cuda.synchronize if device.type == "cuda" else (lambda: None)
+    sync = synchronizer(device)
     calls = {}
     for p, (a, b) in pairs.items():  # warm up, and find how many calls fill min_seconds
         a @ b
