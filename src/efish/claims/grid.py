@@ -1,10 +1,9 @@
 """Many runs' claims at once (``efish compare-claims`` with two or more runs, e.g. the points of a sweep): one table of
 claims x runs and a heatmap of it.
 
-Each run contributes its headline verdict and effect: the recipe's (its top seeds together,
-:mod:`efish.claims.recipe`) where its claims table has one, else its selected seed's. The table keeps both: per run
-``<run> recipe`` and ``<run> recipe effect`` (where the run has the recipe's verdict), then ``<run> verdict`` and
-``<run> effect``.
+The table keeps, per run, ``<run> recipe`` and ``<run> recipe effect`` (where its claims table has the recipe's
+verdict: its top seeds together, :mod:`efish.claims.recipe`), then ``<run> verdict`` and ``<run> effect`` (its
+selected seed's). The heatmap shows each run's headline (:func:`headline`): the recipe's verdict where it has one.
 """
 
 from __future__ import annotations
@@ -48,14 +47,18 @@ def claims_grid(tables: Mapping[str, pd.DataFrame]) -> pd.DataFrame:
 
 
 def headline(grid: pd.DataFrame, runs: list[str]) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """Each run's headline verdict and effect per claim (claims x runs): the recipe's where the run has it."""
-    def pick(run: str, field: str) -> pd.Series:
-        recipe = f"{run} recipe" if field == "verdict" else f"{run} recipe effect"
-        return grid[recipe] if recipe in grid.columns else grid[f"{run} {field}"]
+    """Each run's headline verdict and effect per claim (claims x runs): the recipe's verdict where the run has it,
+    else its selected seed's; the recipe's effect where it has a number, else the selected seed's."""
+    def verdict(run: str) -> pd.Series:
+        return grid.get(f"{run} recipe", grid[f"{run} verdict"])
+
+    def effect(run: str) -> pd.Series:
+        own = grid[f"{run} effect"]
+        return grid[f"{run} recipe effect"].fillna(own) if f"{run} recipe effect" in grid.columns else own
 
     index = grid["claim"]
-    verdicts = pd.DataFrame({run: pick(run, "verdict").to_numpy() for run in runs}, index=index)
-    effects = pd.DataFrame({run: pick(run, "effect").to_numpy() for run in runs}, index=index)
+    verdicts = pd.DataFrame({run: verdict(run).to_numpy() for run in runs}, index=index)
+    effects = pd.DataFrame({run: effect(run).to_numpy(dtype=float) for run in runs}, index=index)
     return verdicts, effects
 
 
@@ -98,7 +101,7 @@ def heatmap_figure(grid: pd.DataFrame, runs: list[str], plt):
     shown = [v for v in VERDICT_COLOURS if (verdicts == v).any().any()]
     ax.legend([Patch(facecolor=VERDICT_COLOURS[v]) for v in shown], shown, fontsize=7, frameon=False,
               loc="upper left", bbox_to_anchor=(1.0, 1.0))
-    ax.set_title("each run's verdict (the recipe's where it has one) and effect", fontsize=8)
+    ax.set_title("each run's verdict and effect\n(the recipe's where it has one)", fontsize=8)
     fig.tight_layout()
     return fig
 
