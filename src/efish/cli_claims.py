@@ -180,7 +180,7 @@ def run_compare_claims(args, cfg, started) -> None:
     names = [name if [n for n, _ in loaded].count(name) == 1 else f"{name} ({i + 1})"
              for i, (name, _) in enumerate(loaded)]  # two folders of one name (two results roots) stay apart
     tables = dict(zip(names, (table for _, table in loaded), strict=True))
-    grid = claims_grid(tables)
+    grid = claims_grid(tables) if len(loaded) > 2 or args.out or args.heatmap else None
     if len(loaded) == 2:
         (name_a, a), (name_b, b) = loaded
         print(compare_claims(a, b, (name_a, name_b)).to_string(index=False))

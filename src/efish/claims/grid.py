@@ -34,7 +34,8 @@ def claims_grid(tables: Mapping[str, pd.DataFrame]) -> pd.DataFrame:
     for run, table in tables.items():
         columns = {"verdict": f"{run} verdict", "effect": f"{run} effect"}
         if has_recipe(table):
-            columns = {"recipe_verdict": f"{run} recipe", "recipe_effect": f"{run} recipe effect", **columns}
+            recipe = {"recipe_verdict": f"{run} recipe", "recipe_effect": f"{run} recipe effect"}
+            columns = {k: v for k, v in recipe.items() if k in table.columns} | columns
         runs.append(table.set_index("claim")[list(columns)].rename(columns=columns))
     panels = pd.concat([t.set_index("claim")["panel"] for t in tables.values()])
     grid = pd.concat(runs, axis=1)
