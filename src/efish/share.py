@@ -138,3 +138,11 @@ def copy_shared(source: str | Path, target: str | Path) -> None:
     for path in [source, *provenance_of(source)]:
         with atomic_path(target.parent / path.name) as tmp:
             shutil.copyfile(path, tmp)
+
+
+def copy_job(sources: Sequence[str], targets: Sequence[str], log: str | Path) -> None:
+    """A share job: each of ``sources`` to the target in the same place (:func:`copy_shared`), and what was copied
+    into ``log``."""
+    for source, target in zip(sources, targets, strict=True):
+        copy_shared(source, target)
+    Path(log).write_text("".join(f"copied {source}\n" for source in sources))

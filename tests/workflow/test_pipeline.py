@@ -267,15 +267,16 @@ def test_overrides_and_run_names_give_their_own_folders(tmp_path):
 @pytest.mark.slow
 def test_a_sweep_plans_a_run_per_point_and_trains_each_seed_once(tmp_path):
     """Points that differ in scale.max_episodes train alike: the first point trains each seed and policy, the
-    second gets copies of what it reads (share_training), and each point runs its own assays, analyses and claims
-    in the folder a single run of its overrides gets."""
+    second gets copies of all of them (share_train, share_train_policy), and each point runs its own assays,
+    analyses and claims in the folder a single run of its overrides gets."""
     from efish.config import compose
 
     result = dry_run(tmp_path, "--config", "scale=smoke", "sweep=scale.max_episodes=2,3")
     assert result.returncode == 0, result.stderr[-2000:]
     jobs = job_counts(result.stdout)
     seeds = len(compose(["scale=smoke"]).scale.seed_numbers())
-    assert jobs["train"] == seeds and jobs["share_training"] >= seeds and "share_rollouts" not in jobs
+    assert jobs["train"] == jobs["share_train"] == seeds and jobs["train_policy"] == jobs["share_train_policy"]
+    assert {rule for rule in jobs if rule.startswith("share_")} == {"share_train", "share_train_policy"}
     assert jobs["evaluate_seed"] == 2 * seeds and jobs["claims"] == 2 and jobs["bench_physics"] == 2
     other = run_name("smoke", ["scale.max_episodes=3"])
     assert f"results/{other}/claims/claims.parquet" in result.stdout

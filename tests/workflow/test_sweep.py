@@ -24,7 +24,7 @@ from efish.layout import (
     training_file,
 )
 from efish.run_plan import PlanError, config_files, run_settings
-from efish.share import STAGES
+from efish.share import STAGES, copy_job, stage_of
 from efish.sweep import grid_points, parse_grid, read_grid, sweep_grid, sweep_overrides, sweep_runs
 
 
@@ -150,3 +150,32 @@ def test_each_stage_names_its_own_files_and_no_analysis_or_claims():
     assert all(paths["rollouts"].fullmatch(p) for p in rollouts)
     assert not any(paths[name].fullmatch(p) for name in paths for p in neither)
     assert not any(paths["training"].fullmatch(p) for p in rollouts)
+
+
+def test_a_rule_belongs_to_the_stage_all_its_outputs_are_in():
+    training, rollouts = STAGES
+    assert stage_of(["results/{run}/train/seed_{seed}/final.pt", "results/{run}/train/seed_{seed}/stage_1.pt"]) \
+        is training
+    assert stage_of(["results/{run}/seeds/seed_{seed}/assays/{assay}/steps.parquet"]) is rollouts
+    assert stage_of(["results/{run}/bench/bench_accuracy.parquet", "figures/{run}/bench/bench_accuracy.png"]) \
+        is rollouts
+    assert stage_of(["results/{run}/analysis/behaviour/{assay}/theil.parquet"]) is None
+    assert stage_of(["results/{run}/analysis/selection/ranking.parquet",
+                     "results/{run}/analysis/selection/selected_seed.txt"]) is None  # the checkpoint runs per point
+    assert stage_of(["results/{run}/assays/{assay}/steps.parquet", "results/{run}/claims/claims.parquet"]) is None
+    assert stage_of(["results/{run}/train/seed_{seed}/final.pt", "results/{run}/scenes/{scene}.parquet"]) is None
+
+
+def test_a_share_job_copies_each_output_with_the_provenance_beside_it(tmp_path):
+    source, target = tmp_path / "results/a/assays/patchy4", tmp_path / "results/b/assays/patchy4"
+    source.mkdir(parents=True)
+    for name, text in (("steps.parquet", "steps"), ("food.parquet", "food"), ("config.yaml", "name: smoke"),
+                       ("provenance.json", "{}")):
+        (source / name).write_text(text)
+    copy_job([str(source / "steps.parquet"), str(source / "food.parquet")],
+             [str(target / "steps.parquet"), str(target / "food.parquet")], tmp_path / "share.log")
+    assert sorted(p.name for p in target.iterdir()) == ["config.yaml", "food.parquet", "provenance.json",
+                                                        "steps.parquet"]
+    assert (target / "food.parquet").read_text() == "food"
+    assert (target / "steps.parquet").stat().st_ino != (source / "steps.parquet").stat().st_ino  # not a hard link
+    assert (tmp_path / "share.log").read_text().count("copied") == 2

@@ -31,13 +31,11 @@ for producer in list(workflow.rules):
             # the rule's own patterns, but for {run}: the share rule's constraint says which runs it serves
             [re.sub(r"\{run,[^{}]*\}", "{run}", str(path)) for path in producer.output],
         log:
-            log("/".join(["share", producer.name, *(f"{{{w}}}" for w in sorted(producer.wildcard_names - {"run"}))])),
+            log(str(Path("share", producer.name, *(f"{{{w}}}" for w in sorted(producer.wildcard_names - {"run"}))))),
         wildcard_constraints:
             run=any_of(map(re.escape, sources)),
         localrule: True
         run:
-            for source, target in zip(input, output):
-                share.copy_shared(source, target)
-            Path(log[0]).write_text("".join(f"copied {source}\n" for source in input))
+            share.copy_job(list(input), list(output), log[0])
 
     workflow.ruleorder(f"share_{producer.name}", producer.name)
