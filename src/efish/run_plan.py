@@ -200,9 +200,9 @@ class Stages:
         return [str(run.stage(k).path(CLAIM_PARTS)) for k in self.rerun] + own
 
     def training_targets(self, run: Run) -> list[str]:
-        """Every policy the run trains: each seed's final.pt and each recipe's its assays act with (in a sweep's
-        ``rule all``: a point that copies its training gets all of it, as if it had trained)."""
-        recipes = sorted({p for policies in self.assay_policies.values() for p in policies} - {SELECTED})
+        """Every policy the run trains: each seed's final.pt and that of each recipe the scale's assays act with (in
+        ``rule all``: a sweep's point that copies its training gets all of it, as if it had trained)."""
+        recipes = sorted({p for name in self.assays for p in self.assay_policies[name]} - {SELECTED})
         return [str(run.path(training_file(name, "final.pt"))) for name in [*map(seed_name, self.seeds), *recipes]]
 
     def targets(self, run: Run) -> list[str]:
@@ -412,9 +412,9 @@ class RunPlan:
         return [str(run.clip(name)) for name in self.clip_assays] + [str(run.contact_sheet)]
 
     def training_targets(self, run: Run) -> list[str]:
-        """Every policy the run trains: each seed's final.pt and each recipe's its assays act with (in a sweep's
-        ``rule all``: a point that copies its training gets all of it, as if it had trained)."""
-        recipes = sorted({p for policies in self.assay_policies.values() for p in policies} - {SELECTED})
+        """Every policy the run trains: each seed's final.pt and that of each recipe the scale's assays act with (in
+        ``rule all``: a sweep's point that copies its training gets all of it, as if it had trained)."""
+        recipes = sorted({p for name in self.assays for p in self.assay_policies[name]} - {SELECTED})
         return [str(run.path(training_file(name, "final.pt"))) for name in [*map(seed_name, self.seeds), *recipes]]
 
     def targets(self, run: Run) -> list[str]:

@@ -272,3 +272,12 @@ def test_a_seed_offset_trains_a_disjoint_set_of_seeds():
     inputs = [path for figure in plan.figure_panels for path in plan.figure_inputs(figure, Run("other"))]
     assert any("train/seed_3/" in t for t in inputs) and any("train/seed_4/" in t for t in inputs)
     assert not any("train/seed_1/" in t or "train/seed_2/" in t for t in inputs)
+
+
+def test_the_training_targets_are_every_seeds_and_every_recipe_an_assay_acts_with(plans, narrow):
+    """What a sweep's rule all asks of each point, so that a point that copies its training has all of it."""
+    assert plans["smoke"].training_targets(Run("smoke")) == [
+        "results/smoke/train/seed_1/final.pt", "results/smoke/train/seed_2/final.pt",
+        "results/smoke/train/homing/final.pt", "results/smoke/train/homing_raycast/final.pt"]
+    assert narrow.training_targets(Run("mine")) == ["results/mine/train/seed_1/final.pt",
+                                                     "results/mine/train/seed_2/final.pt"]
