@@ -3,8 +3,8 @@
 A sweep is a mapping key -> values, given inline (``sweep="train.lr=1e-3,3e-4 analysis.claims_alpha=0.05,0.01"``)
 or as a YAML file of the same mapping (``sweep=sweeps/lr.yaml``). Its points are the product of the values, in
 the order given; each point's overrides follow the run's own (``overrides=``), and the point is a normal run in the
-folder a single run with those overrides gets (:func:`efish.config.run_name`): resumable, and the same folder as
-running that point alone. A value equal to what the run already has (the scale's own
+folder a single run with those overrides gets (:func:`efish.config.run_name`); the sweep resumes as a whole, like
+any Snakemake call. A value equal to what the run already has (the scale's own
 ``analysis.claims_resamples=100`` at smoke) adds no override, so that point is the run without it, whose folder
 may already be up to date. Bad input is one line (:class:`efish.run_plan.PlanError`).
 """
