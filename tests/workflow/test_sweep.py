@@ -25,7 +25,15 @@ from efish.layout import (
 )
 from efish.run_plan import PlanError, config_files, run_settings
 from efish.share import STAGES, copy_job, stage_of
-from efish.sweep import grid_points, parse_grid, read_grid, sweep_grid, sweep_overrides, sweep_runs
+from efish.sweep import (
+    check_alike,
+    grid_points,
+    parse_grid,
+    read_grid,
+    sweep_grid,
+    sweep_overrides,
+    sweep_runs,
+)
 
 
 # ------------------------------------------------------------------ the grid
@@ -179,3 +187,16 @@ def test_a_share_job_copies_each_output_with_the_provenance_beside_it(tmp_path):
     assert (target / "food.parquet").read_text() == "food"
     assert (target / "steps.parquet").stat().st_ino != (source / "steps.parquet").stat().st_ino  # not a hard link
     assert (tmp_path / "share.log").read_text().count("copied") == 2
+
+
+def test_the_points_must_agree_on_what_the_rules_declare_once():
+    """The train rule's outputs (the kept stages) and the assay rule of each assay (hidden states or not)."""
+    def plan(run: str, kept: tuple[int, ...], hidden: set[str]) -> SimpleNamespace:
+        return SimpleNamespace(run=run, stages=SimpleNamespace(kept=kept), buildable_assays=["patchy4", "wide2"],
+                               records_hidden=lambda assay: assay in hidden)
+
+    check_alike([plan("a", (1, 2), {"wide2"}), plan("b", (1, 2), {"wide2"})])
+    with pytest.raises(PlanError, match=r"runs a and b keep different training stages \(scale.keep_stages\)"):
+        check_alike([plan("a", (1, 2), set()), plan("b", (), set())])
+    with pytest.raises(PlanError, match="runs a and b differ in whether patchy4 records hidden states"):
+        check_alike([plan("a", (), set()), plan("b", (), {"patchy4"})])
