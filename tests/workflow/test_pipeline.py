@@ -283,6 +283,21 @@ def test_a_sweep_plans_a_run_per_point_and_trains_each_seed_once(tmp_path):
     assert f"results/{other}/train/seed_1/final.pt" in result.stdout
 
 
+@pytest.mark.slow
+def test_a_sweep_over_an_analysis_key_runs_only_the_analyses_claims_and_figures_again(tmp_path):
+    """Points alike but for analysis.claims_alpha: the second copies the first's training, seed selection episodes,
+    assays, scenes, benchmarks and clips; the first, at the scale's own value, is the plain smoke run."""
+    result = dry_run(tmp_path, "--config", "scale=smoke", "sweep=analysis.claims_alpha=0.05,0.01")
+    assert result.returncode == 0, result.stderr[-2000:]
+    jobs = job_counts(result.stdout)
+    for rule in ("train", "train_policy", "evaluate_seed", "assay", "assay_with_hidden", "scene", "bench_physics",
+                 "render_clip"):
+        assert jobs[rule] == jobs[f"share_{rule}"], rule  # run once, copied once
+    assert jobs["select_seed"] == jobs["claims"] == jobs["contact_sheet"] == 2
+    assert "results/smoke/claims/claims.parquet" in result.stdout
+    assert f"results/{run_name('smoke', ['analysis.claims_alpha=0.01'])}/claims/claims.parquet" in result.stdout
+
+
 @pytest.mark.parametrize("config, message", [
     (["sweep=train.lr"], "efish workflow: sweep: 'train.lr' is not KEY=VALUE,VALUE,..."),
     (["sweep=train.lr=1e-3,3e-4", "run=mine"], "efish workflow: run= names one folder and a sweep makes one per "
