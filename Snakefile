@@ -29,9 +29,10 @@ include: "workflow/rules/figures.smk"
 include: "workflow/rules/render.smk"
 include: "workflow/rules/claims.smk"
 include: "workflow/rules/learning.smk"
+include: "workflow/rules/share.smk"
 
 
 rule all:
     input:
-        PLAN.targets(THIS_RUN),
+        [path for plan in PLANS.values() for path in [*plan.targets(Run(plan.run)), *plan.training_targets(Run(plan.run))]],
     default_target: True

@@ -28,6 +28,7 @@
                                               (--claims) and claims_by_stage.png|pdf (--figures, default
                                               figures/<run>/learning)
     efish compare-claims A B                  two runs' claim verdicts, seeds_agree and effects side by side
+    efish compare-claims A B C --heatmap H.png  claims x runs: a table (--out) and a heatmap
     efish scene NAME [overrides] --out D      field maps of config/scene/NAME.yaml -> D/NAME.parquet
     efish bench physics [overrides] [--json] [--out D]   sensing throughput, fast vs reference
     efish bench accuracy [overrides] [--out D] [--figures D]   accuracy-vs-time study -> table (--out, default
@@ -71,6 +72,7 @@ from .layout import (
     CLAIMS_BY_STAGE_FIGURE,
     CONTACT_SHEET,
     RANKING,
+    RESULTS_ROOT,
     SELECTED_SEED,
     Run,
     assay_folder,
@@ -204,9 +206,20 @@ def _parser() -> argparse.ArgumentParser:
     cbs.add_argument("--figures", type=Path, help="folder for claims_by_stage.png and .pdf "
                                                   f"(default figures/{{run}}/{Path(CLAIMS_BY_STAGE_FIGURE).parent})")
     cbs.set_defaults(handler=run_claims_by_stage)
-    cc = sub.add_parser("compare-claims", help="two runs' claim verdicts and effect sizes side by side")
-    cc.add_argument("a", help="claims.parquet, a claims folder, or a run name (results/<name>/claims/claims.parquet)")
-    cc.add_argument("b", help="the same for the second run")
+    cc = sub.add_parser("compare-claims", help="two or more runs' claim verdicts and effect sizes side by side")
+    cc.add_argument("runs", nargs="*", metavar="RUN",
+                    help="claims.parquet, a claims folder, or a run name (results/<name>/claims/claims.parquet); two "
+                         "or more in all, with --sweep's")
+    cc.add_argument("--sweep", help="also every run of this sweep, in grid order: the grid given to the workflow's "
+                                    "--config sweep= (inline or a YAML file), with --scale and --overrides")
+    cc.add_argument("--scale", help="the sweep's scale (--config scale=; default: the workflow's)")
+    cc.add_argument("--overrides", default="", help="the sweep's run overrides (--config overrides=)")
+    cc.add_argument("--results", type=Path, default=RESULTS_ROOT,
+                    help="where a run name's folder is (default results/)")
+    cc.add_argument("--out", type=Path, help="write the claims x runs table (each run's recipe verdict and effect "
+                                             "where it has them, its verdict and effect) as .parquet or .csv")
+    cc.add_argument("--heatmap", type=Path, help="draw the claims x runs heatmap as a PNG (cell colour: each run's "
+                                                 "recipe verdict, else its verdict; text: that effect)")
     cc.set_defaults(handler=run_compare_claims)  # no overrides: nothing to compose
     pc = sub.add_parser("plan-cluster", help="expected runtime, memory and cores of every job of a scale, checked "
                                              "against a SLURM profile")

@@ -166,8 +166,44 @@ def run_claims_by_stage(args, cfg, started) -> None:
 
 
 def run_compare_claims(args, cfg, started) -> None:
+    """Two runs side by side as before; with ``--out`` or ``--heatmap`` (or more than two runs) also the claims x
+    runs table (:mod:`efish.claims.grid`)."""
+    from .claims.grid import TABLE_SUFFIXES, claims_grid, draw_heatmap, write_table
     from .claims.report import agreement_lines, compare_claims, load_claims
 
-    (name_a, a), (name_b, b) = load_claims(args.a), load_claims(args.b)
-    print(compare_claims(a, b, (name_a, name_b)).to_string(index=False))
-    print("\n".join(agreement_lines(a, b, (name_a, name_b))))
+    wanted = [*args.runs, *(_sweep_runs(args) if args.sweep else [])]
+    if len(wanted) < 2:
+        raise ValueError(f"compare-claims needs two or more runs, got {len(wanted)}: name them or give --sweep")
+    if args.out and args.out.suffix not in TABLE_SUFFIXES:
+        raise ValueError(f"--out {args.out}: the table is written as {' or '.join(TABLE_SUFFIXES)}")
+    loaded = [load_claims(run, args.results) for run in wanted]  # every table read before anything is written
+    names = [name if [n for n, _ in loaded].count(name) == 1 else f"{name} ({i + 1})"
+             for i, (name, _) in enumerate(loaded)]  # two folders of one name (two results roots) stay apart
+    tables = dict(zip(names, (table for _, table in loaded), strict=True))
+    grid = claims_grid(tables) if len(loaded) > 2 or args.out or args.heatmap else None
+    if len(loaded) == 2:
+        (name_a, a), (name_b, b) = loaded
+        print(compare_claims(a, b, (name_a, name_b)).to_string(index=False))
+        print("\n".join(agreement_lines(a, b, (name_a, name_b))))
+    else:
+        print(grid.to_string(index=False))
+    if args.out:
+        write_table(grid, args.out)
+        print(f"wrote {args.out}")
+    if args.heatmap:
+        draw_heatmap(grid, list(tables), args.heatmap)
+        print(f"wrote {args.heatmap}")
+
+
+def _sweep_runs(args) -> list[str]:
+    """The run folders of ``--sweep`` at ``--scale`` with ``--overrides``, in grid order (as the workflow names
+    them)."""
+    import shlex
+
+    from .run_plan import DEFAULT_SCALE, PlanError
+    from .sweep import sweep_runs
+
+    try:
+        return sweep_runs(args.scale or DEFAULT_SCALE, shlex.split(args.overrides), args.sweep)
+    except PlanError as exc:
+        raise ValueError(str(exc)) from None

@@ -50,12 +50,15 @@ from .layout import (
     analysis_table,
     assay_table,
     bench_file,
+    seed_name,
     stacked_seeds_table,
+    training_file,
 )
 from .rollout.assay import check_observation_sizes, condition_configs, policies_needed
 
-#: The keys ``--config`` takes: the scale, extra Hydra overrides for every efish call, and the run's folder name.
-CONFIG_KEYS = ("scale", "overrides", "run")
+#: The keys ``--config`` takes: the scale, extra Hydra overrides for every efish call, the run's folder name, and a
+#: grid of overrides with one run per point (:mod:`efish.sweep`).
+CONFIG_KEYS = ("scale", "overrides", "run", "sweep")
 DEFAULT_SCALE = "laptop"
 #: Where :func:`checked_policies` keeps its answers, relative to Snakemake's working directory.
 CACHE = Path(".snakemake") / "efish"
@@ -76,10 +79,13 @@ def run_settings(config: Mapping[str, object]) -> tuple[str, tuple[str, ...], st
     """The scale, its overrides and the run's folder name from Snakemake's ``--config``.
 
     The folder is the scale as shipped, else the scale and a hash of the overrides, or ``run=NAME``: two configs
-    never share a folder. A misspelt key or a run name that is no folder name is a :class:`PlanError`.
+    never share a folder. A misspelt key, a run name that is no folder name, or a run name with a sweep (whose
+    points each get their own folder) is a :class:`PlanError`.
     """
     if unknown := sorted(set(config) - set(CONFIG_KEYS)):
         raise PlanError(f"unknown --config key(s) {', '.join(unknown)}: the allowed keys are {', '.join(CONFIG_KEYS)}")
+    if "sweep" in config and config.get("run"):
+        raise PlanError("run= names one folder and a sweep makes one per point: leave run= out of a sweep")
     scale = str(config.get("scale", DEFAULT_SCALE))
     overrides = tuple(shlex.split(str(config.get("overrides", ""))))  # e.g. overrides="physics.tolerance=1e-6"
     run = str(config.get("run") or run_name(scale, overrides))
@@ -192,6 +198,12 @@ class Stages:
         fraction 1."""
         own = [str(run.path(CLAIM_PARTS))] if self.last_is_final else []
         return [str(run.stage(k).path(CLAIM_PARTS)) for k in self.rerun] + own
+
+    def training_targets(self, run: Run) -> list[str]:
+        """Every policy the run trains: each seed's final.pt and that of each recipe the scale's assays act with (in
+        ``rule all``: a sweep's point that copies its training gets all of it, as if it had trained)."""
+        recipes = sorted({p for name in self.assays for p in self.assay_policies[name]} - {SELECTED})
+        return [str(run.path(training_file(name, "final.pt"))) for name in [*map(seed_name, self.seeds), *recipes]]
 
     def targets(self, run: Run) -> list[str]:
         """The ``learning`` target: the claims along training. Without kept stages a :class:`PlanError` (the
@@ -406,6 +418,12 @@ class RunPlan:
     def render_targets(self, run: Run) -> list[str]:
         """The clips and the contact sheet of ``run``."""
         return [str(run.clip(name)) for name in self.clip_assays] + [str(run.contact_sheet)]
+
+    def training_targets(self, run: Run) -> list[str]:
+        """Every policy the run trains: each seed's final.pt and that of each recipe the scale's assays act with (in
+        ``rule all``: a sweep's point that copies its training gets all of it, as if it had trained)."""
+        recipes = sorted({p for name in self.assays for p in self.assay_policies[name]} - {SELECTED})
+        return [str(run.path(training_file(name, "final.pt"))) for name in [*map(seed_name, self.seeds), *recipes]]
 
     def targets(self, run: Run) -> list[str]:
         """Every final output of the pipeline for ``run``: the default target."""

@@ -106,7 +106,8 @@ def run_page(page: Path, work: Path) -> list[tuple[Block, float]]:
 def test_the_tutorials_exist():
     assert {p.name for p in PAGES} >= {"index.md", "add-an-assay.md", "add-an-analysis.md", "add-a-panel.md",
                                        "override-configs.md", "read-the-tables.md", "render-an-episode.md",
-                                       "compare-claims.md", "watch-a-run.md"}
+                                       "compare-claims.md", "watch-a-run.md",
+                                       "sweep-a-parameter.md"}
 
 
 @pytest.mark.parametrize("page", PAGES, ids=lambda p: p.stem)

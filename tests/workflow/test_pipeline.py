@@ -250,7 +250,7 @@ def test_a_misspelt_config_key_is_one_line_naming_the_allowed_ones(tmp_path):
     result = dry_run(tmp_path, "--config", "scal=smoke")
     assert result.returncode != 0
     assert result.stderr.strip() == ("efish workflow: unknown --config key(s) scal: the allowed keys are scale, "
-                                     "overrides, run")
+                                     "overrides, run, sweep")
     assert not (tmp_path / "results").exists()
 
 
@@ -262,6 +262,52 @@ def test_overrides_and_run_names_give_their_own_folders(tmp_path):
         assert result.returncode == 0, result.stderr[-2000:]
         assert f"results/{folder}/train/seed_1/final.pt" in result.stdout
         assert f"figures/{folder}/bench/bench_accuracy.pdf" in result.stdout
+
+
+@pytest.mark.slow
+def test_a_sweep_plans_a_run_per_point_and_trains_each_seed_once(tmp_path):
+    """Points that differ in scale.max_episodes train alike: the first point trains each seed and policy, the
+    second gets copies of all of them (share_train, share_train_policy), and each point runs its own assays,
+    analyses and claims in the folder a single run of its overrides gets."""
+    from efish.config import compose
+
+    result = dry_run(tmp_path, "--config", "scale=smoke", "sweep=scale.max_episodes=2,3")
+    assert result.returncode == 0, result.stderr[-2000:]
+    jobs = job_counts(result.stdout)
+    seeds = len(compose(["scale=smoke"]).scale.seed_numbers())
+    assert jobs["train"] == jobs["share_train"] == seeds and jobs["train_policy"] == jobs["share_train_policy"]
+    assert {rule for rule in jobs if rule.startswith("share_")} == {"share_train", "share_train_policy"}
+    assert jobs["evaluate_seed"] == 2 * seeds and jobs["claims"] == 2 and jobs["bench_physics"] == 2
+    other = run_name("smoke", ["scale.max_episodes=3"])
+    assert f"results/{other}/claims/claims.parquet" in result.stdout
+    assert f"results/{other}/train/seed_1/final.pt" in result.stdout
+
+
+@pytest.mark.slow
+def test_a_sweep_over_an_analysis_key_runs_only_the_analyses_claims_and_figures_again(tmp_path):
+    """Points alike but for analysis.claims_alpha: the second copies the first's training, seed selection episodes,
+    assays, scenes, benchmarks and clips; the first, at the scale's own value, is the plain smoke run."""
+    result = dry_run(tmp_path, "--config", "scale=smoke", "sweep=analysis.claims_alpha=0.05,0.01")
+    assert result.returncode == 0, result.stderr[-2000:]
+    jobs = job_counts(result.stdout)
+    for rule in ("train", "train_policy", "evaluate_seed", "assay", "assay_with_hidden", "scene", "bench_physics",
+                 "render_clip"):
+        assert jobs[rule] == jobs[f"share_{rule}"], rule  # run once, copied once
+    assert jobs["select_seed"] == jobs["claims"] == jobs["contact_sheet"] == 2
+    assert "results/smoke/claims/claims.parquet" in result.stdout
+    assert f"results/{run_name('smoke', ['analysis.claims_alpha=0.01'])}/claims/claims.parquet" in result.stdout
+
+
+@pytest.mark.parametrize("config, message", [
+    (["sweep=train.lr"], "efish workflow: sweep: 'train.lr' is not KEY=VALUE,VALUE,..."),
+    (["sweep=train.lr=1e-3,3e-4", "run=mine"], "efish workflow: run= names one folder and a sweep makes one per "
+                                               "point"),
+])
+def test_a_bad_sweep_fails_before_any_job_in_one_line(tmp_path, config, message):
+    result = dry_run(tmp_path, "--config", "scale=smoke", *config)
+    assert result.returncode != 0
+    assert result.stderr.strip().startswith(message) and len(result.stderr.strip().splitlines()) == 1
+    assert not (tmp_path / "results").exists()
 
 
 def test_workflow_lints_clean():

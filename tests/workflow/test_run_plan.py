@@ -275,3 +275,12 @@ def test_a_seed_offset_trains_a_disjoint_set_of_seeds():
     # the homing policies are drawn anew too (seed 3), while a run without an offset keeps the recipe's own seed
     assert plan.policy_args == "scale=smoke scale.seed_offset=2 train.seed=3"
     assert RunPlan.from_config({"scale": "smoke"}, cache=None).policy_args == "scale=smoke"
+
+
+def test_the_training_targets_are_every_seeds_and_every_recipe_an_assay_acts_with(plans, narrow):
+    """What a sweep's rule all asks of each point, so that a point that copies its training has all of it."""
+    assert plans["smoke"].training_targets(Run("smoke")) == [
+        "results/smoke/train/seed_1/final.pt", "results/smoke/train/seed_2/final.pt",
+        "results/smoke/train/homing/final.pt", "results/smoke/train/homing_raycast/final.pt"]
+    assert narrow.training_targets(Run("mine")) == ["results/mine/train/seed_1/final.pt",
+                                                     "results/mine/train/seed_2/final.pt"]

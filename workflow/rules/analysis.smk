@@ -9,8 +9,9 @@
 
 
 for analysis in ANALYSES.values():
-    variants = [(None, "", analysis.assays), (TOP_SEED, "top_seed_", PLAN.seed_analysis_assays(analysis)),
-                (STAGE, "stage_", PLAN.seed_analysis_assays(analysis) if PLAN.stages.rerun else [])]
+    variants = [(None, "", analysis.assays),
+                (TOP_SEED, "top_seed_", across(lambda plan: plan.seed_analysis_assays(analysis))),
+                (STAGE, "stage_", across(lambda plan: plan.seed_analysis_assays(analysis) if plan.stages.rerun else []))]
     for copy, prefix, assays in (v for v in variants if v[2]):
 
         rule:
@@ -25,7 +26,7 @@ for analysis in ANALYSES.values():
             benchmark:
                 benchmark(f"analysis/{analysis.name}/{{assay}}", copy)
             params:
-                overrides=PLAN.args,
+                overrides=ARGS,
                 analysis=analysis.name,
                 tables=lambda wildcards, input: str(Path(input[0]).parent),
                 out=folder_of(analysis.outputs[0]),

@@ -13,11 +13,11 @@ rule assay:
     benchmark:
         benchmark("assays/{assay}")
     params:
-        overrides=PLAN.args,
+        overrides=ARGS,
         out=folder_of("steps"),
         policies=policy_args,
     wildcard_constraints:
-        assay=any_of(PLAN.by_hidden(PLAN.buildable_assays, hidden=False)),
+        assay=any_of(across(lambda plan: plan.by_hidden(plan.buildable_assays, hidden=False))),
     conda:
         "../envs/efish.yaml"
     shell:
@@ -28,7 +28,7 @@ use rule assay as assay_with_hidden with:
     output:
         **assay_outputs(hidden=True),
     wildcard_constraints:
-        assay=any_of(PLAN.by_hidden(PLAN.buildable_assays, hidden=True)),
+        assay=any_of(across(lambda plan: plan.by_hidden(plan.buildable_assays, hidden=True))),
 
 
 # The best-ranked seeds (scale.top_seeds, from the select_seed checkpoint's ranking) rerun assays with their own
@@ -41,7 +41,7 @@ use rule assay as top_seed_assay with:
     output:
         **assay_outputs(hidden=False, copy=TOP_SEED),
     params:
-        overrides=PLAN.top_seed_args,
+        overrides=TOP_SEED_ARGS,
         out=folder_of("steps"),
         policies=policy_args,
     log:
@@ -49,14 +49,14 @@ use rule assay as top_seed_assay with:
     benchmark:
         benchmark("assays/{assay}", TOP_SEED)
     wildcard_constraints:
-        assay=any_of(PLAN.by_hidden(PLAN.top_seed_assays, hidden=False)),
+        assay=any_of(across(lambda plan: plan.by_hidden(plan.top_seed_assays, hidden=False))),
 
 
 use rule top_seed_assay as top_seed_assay_with_hidden with:
     output:
         **assay_outputs(hidden=True, copy=TOP_SEED),
     wildcard_constraints:
-        assay=any_of(PLAN.by_hidden(PLAN.top_seed_assays, hidden=True)),
+        assay=any_of(across(lambda plan: plan.by_hidden(plan.top_seed_assays, hidden=True))),
 
 
 # The supplement's top-seed panels: the top seeds' episodes in scale.top_seed_assays, stacked with seed and rank.
@@ -71,7 +71,7 @@ rule top_seeds:
     benchmark:
         benchmark("seeds/{assay}")
     params:
-        overrides=PLAN.args,
+        overrides=ARGS,
     conda:
         "../envs/efish.yaml"
     shell:

@@ -10,7 +10,7 @@ rule bench_physics:
     benchmark:
         benchmark("bench_physics")
     params:
-        overrides=PLAN.args,
+        overrides=ARGS,
         out=folder_of(0),
     conda:
         "../envs/efish.yaml"
@@ -29,7 +29,7 @@ rule bench_accuracy:
     benchmark:
         benchmark("bench_accuracy")
     params:
-        overrides=PLAN.args,
+        overrides=ARGS,
         out=folder_of("table"),
         figures=folder_of("png"),
     conda:
@@ -49,7 +49,7 @@ rule bench_scaling:
     benchmark:
         benchmark("bench_scaling")
     params:
-        overrides=PLAN.args,
+        overrides=ARGS,
         out=folder_of("table"),
         figures=folder_of("png"),
     conda:

@@ -23,7 +23,7 @@ rule claims:
     benchmark:
         benchmark("claims")
     params:
-        overrides=PLAN.args,
+        overrides=ARGS,
         results=folder_of("table", 1),
         seeds=seed_claims_args,
         out=folder_of("table"),
@@ -45,7 +45,7 @@ use rule claims as top_seed_claims with:
     benchmark:
         benchmark("claims", TOP_SEED)
     params:
-        overrides=PLAN.args,
+        overrides=ARGS,
         results=folder_of("table", 1),
         seeds="",
         out=folder_of("table"),

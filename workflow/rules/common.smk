@@ -1,11 +1,13 @@
-# Shared glue: the run's plan, read once, and the helpers the rules use to name their files. What the workflow
+# Shared glue: the runs' plans, read once, and the helpers the rules use to name their files. What the workflow
 # builds (the scale's assays and policies, the top seeds' and the stages' reruns, the panels by figure, the
-# targets) is planned by efish.run_plan, which the tests reach; every number comes from efish's config.
+# targets) is planned by efish.run_plan, which the tests reach; every number comes from efish's config. A sweep
+# (--config sweep=..., efish.sweep) is one plan per point, each a run folder of its own: a rule asks the plan of
+# its job's {run} (plan_of), and a wildcard constraint allows what any plan builds.
 import re
 import sys
 from pathlib import Path
 
-from efish import run_plan
+from efish import run_plan, sweep
 from efish.analysis.registry import ANALYSES
 from efish.figures.registry import PANELS
 from efish.layout import (
@@ -37,12 +39,35 @@ def fail(message):
     sys.exit(1)
 
 
-# Bad input (a --config key, a run name, a config, an assay file) stops here, in one line. Checking every assay's
-# conditions costs seconds, so the plan keeps its answer in .snakemake/efish/ for the next parse.
+# Bad input (a --config key, a run name, a config, an assay file, a sweep) stops here, in one line. Checking every
+# assay's conditions costs seconds, so each plan keeps its answer in .snakemake/efish/ for the next parse.
 try:
-    PLAN = run_plan.RunPlan.from_config(config)
+    PLANS = {plan.run: plan for plan in sweep.run_plans(config)}
 except run_plan.PlanError as exc:
     fail(str(exc))
+
+
+def plan_of(wildcards):
+    """The plan of the job's run ({run})."""
+    return PLANS[wildcards.run]
+
+
+def of_plan(get):
+    """A params or input function: ``get`` of the job's plan, e.g. ``of_plan(lambda plan: plan.args)``."""
+    return lambda wildcards: get(plan_of(wildcards))
+
+
+def across(get):
+    """What any plan has: the items of ``get(plan)`` over every plan, each once, in the plans' order."""
+    return list(dict.fromkeys(item for plan in PLANS.values() for item in get(plan)))
+
+
+def by_plan(get):
+    """The plans grouped by ``get(plan)``: (value, runs) pairs, for a rule whose outputs differ between points."""
+    groups = {}
+    for plan in PLANS.values():
+        groups.setdefault(get(plan), []).append(plan.run)
+    return list(groups.items())
 
 
 def any_of(names):
@@ -50,8 +75,17 @@ def any_of(names):
     return "|".join(names) or "^$"
 
 
+# What every efish call of a job is given: the scale and the overrides of its run (capped for the reruns).
+ARGS = of_plan(lambda plan: plan.args)
+STAGE_ARGS = of_plan(lambda plan: plan.stage_args)
+TOP_SEED_ARGS = of_plan(lambda plan: plan.top_seed_args)
+POLICY_ARGS = of_plan(lambda plan: plan.policy_args)
+# What every plan keeps of its training (the train rule's outputs): the same in every point (efish.sweep).
+KEPT_STAGES = next(iter(PLANS.values())).stages.kept
+
+
 wildcard_constraints:
-    run=re.escape(PLAN.run),
+    run=any_of(map(re.escape, PLANS)),
     seed=r"\d+",
     stage=r"\d+",
     assay=r"[A-Za-z0-9_\-]+",
@@ -59,7 +93,6 @@ wildcard_constraints:
 
 # ------------------------------------------------------------------ paths: every one from efish.layout
 RULE_RUN = Run("{run}")  # the rules' patterns ({run} and the rule's other wildcards)
-THIS_RUN = Run(PLAN.run)  # this run's own files (rule all, panel inputs)
 
 
 # The copies of the layout inside a run (efish.layout.Run.within): a top seed's and a training stage's.
@@ -147,7 +180,7 @@ def assay_policies_input(wildcards):
             return stage_policy(wildcards.run, selected_seed(wildcards), stage)
         return seed_policy(wildcards, selected_seed(wildcards) if seed is None else seed)
 
-    return {name: path(name) for name in PLAN.policies_of(wildcards.assay)}
+    return {name: path(name) for name in plan_of(wildcards).policies_of(wildcards.assay)}
 
 
 def policy_args(wildcards, input):
@@ -158,7 +191,7 @@ def policy_args(wildcards, input):
 def top_seeds(wildcards):
     """The ``scale.top_seeds`` best-ranked seeds, from the select_seed checkpoint's ranking table."""
     return run_plan.top_seeds(checkpoints.select_seed.get(run=wildcards.run).output.ranking,
-                              PLAN.cfg.scale.top_seeds)
+                              plan_of(wildcards).cfg.scale.top_seeds)
 
 
 def other_top_seeds(wildcards):
@@ -195,20 +228,21 @@ def claims_inputs(wildcards):
     seed's claims (wildcard {seed}) or a training stage's ({stage}) those its rerun assays write in its copy of the
     layout."""
     copy = copy_of(wildcards)
-    paths = PLAN.claim_tables if copy is None else PLAN.seed_claim_tables
+    plan = plan_of(wildcards)
+    paths = plan.claim_tables if copy is None else plan.seed_claim_tables
     return [results(path, copy, Run(wildcards.run)) for path in paths]
 
 
 # ------------------------------------------------------------------ learning
 def stage_policies(wildcards):
     """The selected seed's stage files, k = 1..K (their records hold the env steps trained)."""
-    return [stage_policy(wildcards.run, selected_seed(wildcards), k) for k in PLAN.stages.kept]
+    return [stage_policy(wildcards.run, selected_seed(wildcards), k) for k in plan_of(wildcards).stages.kept]
 
 
 def learning_target(wildcards):
-    """The learning target's inputs; without kept stages one line and no job."""
+    """The learning target's inputs, every run's; without kept stages one line and no job."""
     try:
-        return PLAN.stages.targets(THIS_RUN)
+        return [path for plan in PLANS.values() for path in plan.stages.targets(Run(plan.run))]
     except run_plan.PlanError as exc:
         fail(str(exc))
 

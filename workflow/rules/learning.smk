@@ -13,20 +13,20 @@ use rule assay as stage_assay with:
     benchmark:
         benchmark("assays/{assay}", STAGE)
     params:
-        overrides=PLAN.stage_args,
+        overrides=STAGE_ARGS,
         out=folder_of("steps"),
         policies=policy_args,
     wildcard_constraints:
-        assay=any_of(PLAN.by_hidden(PLAN.seed_claim_assays, hidden=False)),
-        stage=any_of(map(str, PLAN.stages.rerun)),
+        assay=any_of(across(lambda plan: plan.by_hidden(plan.seed_claim_assays, hidden=False))),
+        stage=any_of(across(lambda plan: map(str, plan.stages.rerun))),
 
 
 use rule stage_assay as stage_assay_with_hidden with:
     output:
         **assay_outputs(hidden=True, copy=STAGE),
     wildcard_constraints:
-        assay=any_of(PLAN.by_hidden(PLAN.seed_claim_assays, hidden=True)),
-        stage=any_of(map(str, PLAN.stages.rerun)),
+        assay=any_of(across(lambda plan: plan.by_hidden(plan.seed_claim_assays, hidden=True))),
+        stage=any_of(across(lambda plan: map(str, plan.stages.rerun))),
 
 
 use rule claims as stage_claims with:
@@ -41,7 +41,7 @@ use rule claims as stage_claims with:
     benchmark:
         benchmark("claims", STAGE)
     params:
-        overrides=PLAN.args,
+        overrides=ARGS,
         results=folder_of("table", 1),
         seeds="",
         out=folder_of("table"),
@@ -49,7 +49,7 @@ use rule claims as stage_claims with:
 
 rule claims_by_stage:
     input:
-        parts=PLAN.stages.parts(RULE_RUN),
+        parts=lambda wildcards: plan_of(wildcards).stages.parts(Run(wildcards.run)),
         policies=stage_policies,
         claims=results(CLAIMS_TABLE),
     output:
@@ -59,10 +59,10 @@ rule claims_by_stage:
     benchmark:
         benchmark("learning")
     params:
-        overrides=PLAN.args,
-        stages=lambda wildcards, input: run_plan.keyed(PLAN.stages.kept, input.parts),
-        policies=lambda wildcards, input: run_plan.keyed(PLAN.stages.kept, input.policies),
-        episodes=run_plan.keyed(PLAN.stages.kept, PLAN.stages.episodes),
+        overrides=ARGS,
+        stages=lambda wildcards, input: run_plan.keyed(KEPT_STAGES, input.parts),
+        policies=lambda wildcards, input: run_plan.keyed(KEPT_STAGES, input.policies),
+        episodes=of_plan(lambda plan: run_plan.keyed(plan.stages.kept, plan.stages.episodes)),
         out=folder_of("table"),
         figures=folder_of("png"),
     conda:

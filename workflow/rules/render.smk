@@ -16,10 +16,10 @@ rule render_clip:
     benchmark:
         benchmark("render/{assay}")
     params:
-        overrides=PLAN.args,
+        overrides=ARGS,
         tables=lambda wildcards, input: str(Path(input.steps).parent),
     wildcard_constraints:
-        assay=any_of(PLAN.clip_assays),
+        assay=any_of(across(lambda plan: plan.clip_assays)),
     conda:
         "../envs/efish.yaml"
     shell:
@@ -28,7 +28,7 @@ rule render_clip:
 
 rule contact_sheet:
     input:
-        [str(RULE_RUN.panel(p.figure, p.name, "png")) for p in PLAN.drawable],
+        lambda wildcards: [str(Run(wildcards.run).panel(p.figure, p.name, "png")) for p in plan_of(wildcards).drawable],
     output:
         report(str(RULE_RUN.contact_sheet), caption="../report/contact_sheet.rst", category="Contact sheet"),
     log:
@@ -36,9 +36,9 @@ rule contact_sheet:
     benchmark:
         benchmark("render/contact_sheet")
     params:
-        overrides=PLAN.args,
+        overrides=ARGS,
         figures=folder_of(0),
-        drawn=len(PLAN.drawable),
+        drawn=of_plan(lambda plan: len(plan.drawable)),
         registered=len(PANELS),
     conda:
         "../envs/efish.yaml"

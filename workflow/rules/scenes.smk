@@ -10,7 +10,7 @@ rule scene:
     benchmark:
         benchmark("scenes/{scene}")
     params:
-        overrides=PLAN.args,
+        overrides=ARGS,
         out=folder_of(0),
     wildcard_constraints:
         scene=r"[A-Za-z0-9_\-]+",

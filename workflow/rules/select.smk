@@ -12,7 +12,7 @@ rule evaluate_seed:
     benchmark:
         benchmark(f"selection/{seed_name('{seed}')}")
     params:
-        overrides=PLAN.args,
+        overrides=ARGS,
         out=folder_of(0),
     conda:
         "../envs/efish.yaml"
@@ -22,7 +22,8 @@ rule evaluate_seed:
 
 checkpoint select_seed:
     input:
-        expand(results(selection_table("{seed}", "episodes")), seed=PLAN.seeds, allow_missing=True),
+        lambda wildcards: [results(selection_table(seed, "episodes"), run=Run(wildcards.run))
+                           for seed in plan_of(wildcards).seeds],
     output:
         ranking=results(RANKING),
         seed=results(SELECTED_SEED),
@@ -31,7 +32,7 @@ checkpoint select_seed:
     benchmark:
         benchmark("select_seed")
     params:
-        overrides=PLAN.args,
+        overrides=ARGS,
         out=folder_of("ranking"),
     conda:
         "../envs/efish.yaml"

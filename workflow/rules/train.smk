@@ -10,13 +10,13 @@ rule train:
     output:
         final=results(training_file(seed_name("{seed}"), "final.pt")),
         metrics=results(training_file(seed_name("{seed}"), "metrics.parquet")),
-        **{stage_name(k): results(training_file(seed_name("{seed}"), stage_file(k))) for k in PLAN.stages.kept},
+        **{stage_name(k): results(training_file(seed_name("{seed}"), stage_file(k))) for k in KEPT_STAGES},
     log:
         log(f"train/{seed_name('{seed}')}"),
     benchmark:
         benchmark(f"train/{seed_name('{seed}')}")
     params:
-        overrides=PLAN.args,
+        overrides=ARGS,
         out=folder_of("final"),
     conda:
         "../envs/efish.yaml"
@@ -33,10 +33,10 @@ rule train_policy:
     benchmark:
         benchmark("train/{policy}")
     params:
-        overrides=PLAN.policy_args,
+        overrides=POLICY_ARGS,
         out=folder_of("final"),
     wildcard_constraints:
-        policy="|".join(PLAN.policy_recipes),
+        policy=any_of(across(lambda plan: plan.policy_recipes)),
     conda:
         "../envs/efish.yaml"
     shell:
