@@ -78,11 +78,15 @@ def read_parquet(path: str | os.PathLike, what: str = "a table"):
     """A Parquet file as a DataFrame; a truncated or foreign file is one clear ``ValueError`` naming it.
 
     A missing file stays a ``FileNotFoundError`` (an ``OSError``, which the CLI reports in one line too).
+    The file is read through one open handle: a table that :func:`atomic_path` replaces while it is read (a
+    training's ``metrics.parquet``, rewritten every update) is read whole, old or new. ``pd.read_parquet(path)``
+    takes the file's size and then opens it again, so a replacement between the two reads a torn table.
     """
     import pandas as pd
 
     try:
-        return pd.read_parquet(path)
+        with open(path, "rb") as handle:
+            return pd.read_parquet(handle)
     except OSError:
         raise
     except Exception as exc:  # pyarrow raises its own types for files that are not Parquet

@@ -22,7 +22,7 @@ from pathlib import Path
 import pandas as pd
 
 from .config import compose, config_dir
-from .io import atomic_path
+from .io import atomic_path, read_parquet
 from .layout import FINAL_POLICY, TRAINING_METRICS, Run, seed_name, training_folder
 
 NOT_STARTED, RUNNING, FINISHED = "not started", "running", "finished"
@@ -88,7 +88,7 @@ def read_metrics(job: Job) -> pd.DataFrame | None:
     path = job.folder / TRAINING_METRICS
     try:
         written = path.stat().st_mtime
-        metrics = pd.read_parquet(path)
+        metrics = read_parquet(path, "a training's metrics")  # one open handle: never a torn table
     except FileNotFoundError:
         return None
     metrics.attrs["written"] = written
