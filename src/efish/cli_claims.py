@@ -168,8 +168,9 @@ def run_claims_by_stage(args, cfg, started) -> None:
 def run_compare_claims(args, cfg, started) -> None:
     """Two runs side by side as before; with ``--out`` or ``--heatmap`` (or more than two runs) also the claims x
     runs table (:mod:`efish.claims.grid`)."""
-    from .claims.grid import TABLE_SUFFIXES, claims_grid, draw_heatmap, write_table
+    from .claims.grid import TABLE_SUFFIXES, claims_grid, write_table
     from .claims.report import agreement_lines, compare_claims, load_claims
+    from .figures.claims_grid import draw_heatmap
 
     wanted = [*args.runs, *(_sweep_runs(args) if args.sweep else [])]
     if len(wanted) < 2:

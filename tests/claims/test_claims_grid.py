@@ -7,8 +7,9 @@ import pandas as pd
 import pytest
 from matplotlib.colors import to_hex
 
-from efish.claims.grid import claims_grid, headline, heatmap_figure
+from efish.claims.grid import claims_grid, headline
 from efish.cli import main
+from efish.figures.claims_grid import heatmap_figure
 from efish.figures.learning import VERDICT_COLOURS
 
 from ..test_cli import claims_rows
