@@ -164,27 +164,59 @@ def mathml(tex: str, display: bool) -> str:
     return markup.replace("\n", "")
 
 
-def _inline_math(text: str) -> str:
-    """``$...$`` outside inline code spans to MathML."""
+class MathStash:
+    """LaTeX swapped for plain-word tokens before Markdown parses a page, and MathML swapped back in after.
+
+    MathML is HTML, and Markdown reads a source line that starts with an HTML tag as a raw HTML block: an
+    equation at the start of a line would end the paragraph or list item it sits in. A token is a plain word, so
+    the page's blocks (lists, paragraphs, tables) are parsed as if the equation were any other word.
+    """
+
+    def __init__(self, page_id: int) -> None:
+        self.prefix = f"efishmath{page_id}x"
+        self.markup: list[str] = []
+
+    def token(self, tex: str, display: bool) -> str:
+        """A token standing for ``tex``; its MathML is kept until :meth:`restore`."""
+        self.markup.append(f'<div class="math">{mathml(tex, True)}</div>' if display else mathml(tex, False))
+        return f"{self.prefix}{len(self.markup) - 1}z"
+
+    def restore(self, html_text: str) -> str:
+        """The page's HTML with every token replaced by its MathML (a display token's paragraph by the block)."""
+        def swap(m: re.Match) -> str:
+            return self.markup[int(m["index"])]
+        token = rf"{self.prefix}(?P<index>\d+)z"
+        html_text = re.sub(rf"<p>{token}</p>", swap, html_text)
+        return re.sub(token, swap, html_text)
+
+
+def _inline_math(text: str, stash: MathStash) -> str:
+    """``$...$`` outside inline code spans to tokens."""
+    def math(m: re.Match) -> str:
+        return stash.token(m["tex"], display=False)
+
     parts, last = [], 0
     for code in INLINE_CODE.finditer(text):
-        parts += [INLINE_MATH.sub(lambda m: mathml(m["tex"], False), text[last:code.start()]), code.group(0)]
+        parts += [INLINE_MATH.sub(math, text[last:code.start()]), code.group(0)]
         last = code.end()
-    parts.append(INLINE_MATH.sub(lambda m: mathml(m["tex"], False), text[last:]))
+    parts.append(INLINE_MATH.sub(math, text[last:]))
     return "".join(parts)
 
 
-def render_math(markdown: str) -> str:
-    """Fenced ``math`` blocks and inline ``$...$`` to MathML; other code blocks are left as they are."""
+def stash_math(markdown: str, stash: MathStash) -> str:
+    """Fenced ``math`` blocks and inline ``$...$`` to tokens of ``stash``; other code blocks are left as they are.
+
+    A display block becomes a token on a line of its own, at the fence's indent, so that it stays inside the list
+    item it was written in."""
     out, last = [], 0
     for block in FENCE.finditer(markdown):
-        out.append(_inline_math(markdown[last:block.start()]))
+        out.append(_inline_math(markdown[last:block.start()], stash))
         if block["info"].strip() == "math":
-            out.append(f'{block["indent"]}<div class="math">{mathml(block["body"], True)}</div>\n')
+            out.append(f'{block["indent"]}{stash.token(block["body"], display=True)}\n')
         else:
             out.append(block.group(0))
         last = block.end()
-    out.append(_inline_math(markdown[last:]))
+    out.append(_inline_math(markdown[last:], stash))
     return "".join(out)
 
 
@@ -210,11 +242,21 @@ def link_docs(markdown: str, page_path: str) -> str:
     return "".join(out)
 
 
+_STASHES: dict[str, MathStash] = {}
+
+
 def on_page_markdown(markdown: str, page: Any, config: Any, files: Any) -> str:
-    """Fill the generated parts a page asks for, then render its math."""
+    """Fill the generated parts a page asks for, then set its math aside as tokens (see :class:`MathStash`)."""
     def generated(match: re.Match) -> str:
         if match[1] not in GENERATED:
             raise ValueError(f"{page.file.src_path}: unknown generated part {match[1]!r} "
                              f"(known: {', '.join(GENERATED)})")
         return link_docs(GENERATED[match[1]](), page.file.src_path)
-    return render_math(MARKER.sub(generated, markdown))
+    stash = _STASHES[page.file.src_path] = MathStash(len(_STASHES))
+    return stash_math(MARKER.sub(generated, markdown), stash)
+
+
+def on_page_content(html_text: str, page: Any, config: Any, files: Any) -> str:
+    """Put the page's equations, as MathML, where their tokens are."""
+    stash = _STASHES.pop(page.file.src_path, None)
+    return html_text if stash is None else stash.restore(html_text)
