@@ -136,16 +136,41 @@ def tables_reference() -> str:
 # --------------------------------------------------------------------- the command-line reference
 
 
+def _subcommands(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:
+    """A parser's subcommands by name (none for a leaf command)."""
+    actions = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
+    return dict(actions[0].choices) if actions else {}
+
+
+def _docs_read(parser: argparse.ArgumentParser) -> list[str]:
+    """The documentation pages a command's help cites (its description, epilog and arguments' help), once each and
+    in order, as Markdown links titled as the site's navigation titles them (efish.cli_support.DOC_PAGES)."""
+    from efish.cli_support import DOC_PAGES
+
+    texts = [parser.description, parser.epilog, *(a.help for a in parser._actions)]
+    paths = dict.fromkeys(m.group(0) for text in texts if text for m in DOC_REFERENCE.finditer(text))
+    return [f"[{DOC_PAGES[path.partition('#')[0]]}]({path})" for path in paths]
+
+
+def _command_reference(name: str, parser: argparse.ArgumentParser, level: int) -> list[str]:
+    """Markdown lines of one command: its help as argparse prints it, the pages it cites as links (the help sits in a
+    code block, where no link can be), then its subcommands one heading level down."""
+    anchor = "-".join(name.split()[1:]) or "efish"
+    out = [f"{'#' * level} `{name}` {{#{anchor}}}", "", "```text", parser.format_help().rstrip(), "```", ""]
+    if pages := _docs_read(parser):
+        out += ["Read: " + "; ".join(pages) + ".", ""]
+    child_level = level if name == "efish" else level + 1  # the commands beside efish, a command's studies below
+    for sub_name, sub in _subcommands(parser).items():
+        out += _command_reference(f"{name} {sub_name}", sub, child_level)
+    return out
+
+
 def cli_reference() -> str:
-    """Markdown: ``efish --help`` and every subcommand's help, as argparse prints them."""
+    """Markdown: ``efish --help`` and every (sub)command's help, as argparse prints them (``bench`` studies as
+    subsections of ``efish bench``), each followed by links to the pages it cites."""
     from efish.cli import _parser
 
-    parser = _parser()
-    out = ["## `efish` {#efish}", "", "```text", parser.format_help().rstrip(), "```", ""]
-    subparsers = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
-    for name, sub in subparsers.choices.items():
-        out += [f"## `efish {name}` {{#{name}}}", "", "```text", sub.format_help().rstrip(), "```", ""]
-    return "\n".join(out)
+    return "\n".join(_command_reference("efish", _parser(), 2))
 
 
 GENERATED = {"config": config_reference, "tables": tables_reference, "cli": cli_reference}
@@ -226,19 +251,26 @@ MARKER = re.compile(r"^<!-- efish:(\w+) -->$", re.M)
 DOC_REFERENCE = re.compile(r"\bdocs/(?P<page>[\w/-]+\.md)(?P<anchor>#[\w-]+)?")
 
 
+LINK_TO_DOCS = re.compile(r"\]\(" + DOC_REFERENCE.pattern + r"\)")
+
+
 def link_docs(markdown: str, page_path: str) -> str:
-    """The code's ``docs/<page>.md#anchor`` references, outside code blocks, as links relative to ``page_path``."""
+    """The code's ``docs/<page>.md#anchor`` references, outside code blocks, as links relative to ``page_path``: a
+    bare one becomes a link titled by its page, a Markdown link to one (``[title](docs/<page>.md)``) keeps its title."""
     depth = page_path.count("/")
 
-    def link(m: re.Match) -> str:
-        target = "../" * depth + m["page"] + (m["anchor"] or "")
-        return f"[{m['page'].removesuffix('.md')}]({target})"
+    def target(m: re.Match) -> str:
+        return "../" * depth + m["page"] + (m["anchor"] or "")
+
+    def outside_code(text: str) -> str:
+        text = LINK_TO_DOCS.sub(lambda m: f"]({target(m)})", text)  # first: its target then no longer says docs/
+        return DOC_REFERENCE.sub(lambda m: f"[{m['page'].removesuffix('.md')}]({target(m)})", text)
 
     out, last = [], 0
     for block in FENCE.finditer(markdown):
-        out += [DOC_REFERENCE.sub(link, markdown[last:block.start()]), block.group(0)]
+        out += [outside_code(markdown[last:block.start()]), block.group(0)]
         last = block.end()
-    out.append(DOC_REFERENCE.sub(link, markdown[last:]))
+    out.append(outside_code(markdown[last:]))
     return "".join(out)
 
 

@@ -1,11 +1,15 @@
-"""efish.io: atomic writes give outputs the mode a plain open() would, not mkstemp's private 0600."""
+"""efish.io: atomic writes give outputs the mode a plain open() would, not mkstemp's private 0600, and the record
+beside every output says which efish made it."""
 
 from __future__ import annotations
 
+import json
 import os
 import stat
+from datetime import datetime, timezone
 
-from efish.io import atomic_path
+import efish
+from efish.io import atomic_path, write_run_metadata
 
 
 def test_an_atomic_write_gets_the_umask_mode(tmp_path):
@@ -32,3 +36,12 @@ def test_a_failed_write_leaves_nothing(tmp_path):
     except RuntimeError:
         pass
     assert list(tmp_path.iterdir()) == []
+
+
+def test_provenance_records_the_efish_version_beside_the_config(tmp_path):
+    """What ``efish --version`` prints is what each output's provenance.json says made it."""
+    write_run_metadata(tmp_path, "scale: smoke\n", datetime.now(timezone.utc), {"overrides": ["scale=smoke"]},
+                       name="panel.provenance.json")
+    prov = json.loads((tmp_path / "panel.provenance.json").read_text())
+    assert prov["efish_version"] == efish.__version__ and prov["efish_version"]
+    assert prov["overrides"] == ["scale=smoke"] and (tmp_path / "config.yaml").read_text() == "scale: smoke\n"

@@ -49,6 +49,13 @@ choices (``arena=patchy70``). ``efish train`` composes ``policy=foraging`` first
 training arenas, sampled per episode (config/policy/). The benchmarks' sizes are ``bench.*`` fields
 (``efish config`` lists them); a bench command's flags override them for one
 run. Every error is one line on stderr, exit code 2, and nothing is written.
+
+``efish --version`` prints the installed version (the one provenance.json records). ``--help`` is the user's
+documentation, so it is written with :mod:`efish.cli_support`'s helpers: every (sub)command says what it does,
+what it writes and which pages of the docs to read (:func:`~efish.cli_support.add_command`, pages by their title
+in the site's navigation and their path under docs/), every argument has a help line, and the overrides are
+worded once (:func:`~efish.cli_support.add_overrides`). tests/test_cli_help.py holds them to it; the site's
+command-line reference (docs/reference/cli.md) is this parser's help, generated when the site is built.
 """
 
 from __future__ import annotations
@@ -62,8 +69,9 @@ from datetime import datetime, timezone
 from pathlib import Path
 from typing import Sequence
 
+from ._version import __version__
 from .cli_claims import run_claims, run_claims_by_stage, run_compare_claims
-from .cli_support import run_of, write_metadata
+from .cli_support import HelpFormatter, add_command, add_overrides, run_of, see_docs, write_metadata
 from .config import ConfigError, compose, to_yaml
 from .layout import (
     ANALYSIS_SETTINGS,
@@ -81,25 +89,89 @@ from .layout import (
     training_folder,
 )
 
+DESCRIPTION = """\
+The command line of efish, a reproduction of a multi-agent RL study of weakly electric fish. Each command composes \
+the config (config/ and the overrides), calls one function of the efish package and prints or writes what it made; \
+an output folder also gets config.yaml and provenance.json (the resolved config; the command, its start and end, \
+the efish and package versions)."""
+
+EPILOG = f"""\
+Overrides are Hydra's key=value (physics.image_order=2) or a config group's choice (arena=patchy70); efish config \
+prints the resolved config and so lists every key. efish train composes policy=foraging first (the paper's sampled \
+training arenas); a bench command's flags override its bench.* sizes for one run. Every error is one line on \
+stderr, exit code 2, and nothing is written.
+
+examples:
+  efish config scale=smoke              the smoke scale's config
+  efish plan arena=patchy70             which effects run in that arena, and why
+  efish train scale=smoke train.seed=1  train one seed (results/smoke/train/seed_1)
+  efish schema episodes                 the columns of episodes.parquet
+  efish COMMAND --help                  what a command does and writes
+
+{see_docs("docs/reference/cli.md", "docs/getting-started.md", "docs/tutorials/override-configs.md")}"""
+
 
 def _parser() -> argparse.ArgumentParser:
     """The command line; every (sub)command's parser sets ``handler``, the function :func:`main` calls."""
-    p = argparse.ArgumentParser(prog="efish", description=__doc__.split("\n\n")[0],
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
-    sub = p.add_subparsers(dest="command", required=True)
-    c = sub.add_parser("config", help="print the resolved config")
-    c.add_argument("overrides", nargs="*")
+    p = argparse.ArgumentParser(prog="efish", description=DESCRIPTION, epilog=EPILOG, formatter_class=HelpFormatter)
+    p.add_argument("--version", action="version", version=f"%(prog)s {__version__}",
+                   help="print efish's version (the installed package's) and exit")
+    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND",
+                           help="what to do (efish COMMAND --help says more)")
+    for add in (_config_commands, _training_commands, _assay_commands, _figure_commands, _claims_commands,
+                _cluster_commands):
+        add(sub)
+    _bench_parsers(sub)
+    return p
+
+
+def _add_out(parser: argparse.ArgumentParser, help_: str, required: bool = False) -> None:
+    """``--out``, the folder or file a command writes (``help_``: what goes there, and its default)."""
+    parser.add_argument("--out", type=Path, required=required, help=help_)
+
+
+def _add_json(parser: argparse.ArgumentParser) -> None:
+    """``--json``: print the command's result as JSON (records for a table), for a script to read."""
+    parser.add_argument("--json", action="store_true", help="print JSON instead of the table")
+
+
+def _config_commands(sub: argparse._SubParsersAction) -> None:
+    """The commands that only print what a config says: config, plan, schema."""
+    c = add_command(sub, "config", "print the resolved config",
+                    "Print the config the overrides compose to, as YAML: every key a command reads, with its value. "
+                    "Writes nothing.", "docs/tutorials/override-configs.md", "docs/reference/config.md")
+    add_overrides(c, example="scale=smoke physics.image_order=2")
     c.set_defaults(handler=_config)
-    pl = sub.add_parser("plan", help="print the effect plan of a scene")
-    pl.add_argument("overrides", nargs="*")
+    pl = add_command(sub, "plan", "which physical effects the simulator computes, and why",
+                     "Print the effect plan of the configured scene: each physical effect (wall images, induction, "
+                     "far-field interpolation, ...) on or off, and the setting that decides it. Writes nothing.",
+                     "docs/model/effect-plan.md")
+    add_overrides(pl, example="arena=patchy70 'env.muted=[0,1,2,3]'")
     pl.set_defaults(handler=_plan)
-    tr = sub.add_parser("train", help="train one seed with recurrent MAPPO (resumes from a checkpoint in --out)")
-    tr.add_argument("overrides", nargs="*")
-    tr.add_argument("--out", type=Path, help="output folder (default results/{run}/train/seed_{seed})")
+    sch = add_command(sub, "schema", "print a rollout table's columns and their meaning",
+                      "Print the columns of one rollout table with their type, unit and meaning. Writes nothing.",
+                      "docs/reference/tables.md", "docs/tutorials/read-the-tables.md")
+    sch.add_argument("table", choices=("steps", "episodes", "food", "hidden", "conditions"),
+                     help="the table: steps, episodes, food, hidden or conditions")
+    add_overrides(sch, note="they do not change the columns")
+    sch.set_defaults(handler=_schema)
+
+
+def _training_commands(sub: argparse._SubParsersAction) -> None:
+    """Training a seed, watching the runs train, ranking and stacking the seeds: train, watch, select, stack-seeds."""
+    tr = add_command(sub, "train", "train one seed with recurrent MAPPO",
+                     "Train one seed with recurrent MAPPO on the paper's sampled training arenas (policy=foraging is "
+                     "composed before the overrides), resuming from a checkpoint in --out. Writes checkpoint.pt, "
+                     "metrics.parquet (a row per update), final.pt, config.yaml and provenance.json.",
+                     "docs/methods/training.md")
+    add_overrides(tr, example="scale=smoke train.seed=3", note="policy= or arena= replaces the training arenas")
+    _add_out(tr, "output folder (default results/{run}/train/seed_{seed})")
     tr.add_argument("--restart", action="store_true", help="discard a checkpoint in --out and start afresh")
     tr.set_defaults(handler=_train, recipe=TRAINING_RECIPE)
-    wa = sub.add_parser("watch", help="a live table of every training job of a run: update, return, entropy, KL, "
-                                      "speed, ETA and state, from their metrics.parquet")
+    wa = add_command(sub, "watch", "a live table of every training job of a run",
+                     "Show every training job of a run in a table refreshed in place: update, return, entropy, KL, "
+                     "speed, ETA and state, from their metrics.parquet. Writes nothing but the --plot PNG.",
+                     "docs/tutorials/watch-a-run.md", "docs/methods/training.md#live-logs")
     wa.add_argument("run", help="the run's folder name under --results (smoke, laptop-453280a3)")
     wa.add_argument("--results", type=Path, default=Path("results"), help="the results root (default results)")
     wa.add_argument("--interval", type=float, default=10.0, help="seconds between refreshes (default 10)")
@@ -108,73 +180,108 @@ def _parser() -> argparse.ArgumentParser:
                     help="also write return, entropy and KL against env steps, one line per job, to this PNG "
                          "(rewritten at every refresh)")
     wa.set_defaults(handler=_watch)  # no overrides: nothing to compose
-    asy = sub.add_parser("assay", help="run an assay with a trained policy into Parquet tables")
-    asy.add_argument("overrides", nargs="*")
+    sel = add_command(sub, "select", "rank seeds by their selection episodes and choose one",
+                      "Rank the trained seeds by their selection episodes and choose the seed the assays act with. "
+                      "Writes ranking.parquet, selected_seed.txt, config.yaml and provenance.json to --out.",
+                      "docs/methods/training.md#seed-selection")
+    add_overrides(sel, example="scale=laptop", note="recorded in config.yaml")
+    sel.add_argument("--episodes", nargs="+", type=Path, required=True,
+                     help="episodes.parquet files in folders named seed_<n>")
+    _add_out(sel, "folder for ranking.parquet and selected_seed.txt", required=True)
+    sel.set_defaults(handler=_select)
+    st = add_command(sub, "stack-seeds", "stack the top seeds' tables into one",
+                     "Stack one table of each top seed (each under seed_<n>/) into one table with seed and rank "
+                     "columns, in the order of the seed ranking. Writes the stacked .parquet (--out).",
+                     "docs/methods/training.md#seed-selection")
+    add_overrides(st, example="scale=laptop")
+    st.add_argument("--tables", nargs="+", type=Path, required=True, help="the seeds' tables, each under seed_<n>/")
+    st.add_argument("--ranking", type=Path, required=True, help=f"the seed ranking ({RANKING})")
+    _add_out(st, "the stacked table (.parquet)", required=True)
+    st.set_defaults(handler=_stack_seeds)
+
+
+def _assay_commands(sub: argparse._SubParsersAction) -> None:
+    """Running the trained policies and analysing what they did: assay, analyze, scene."""
+    asy = add_command(sub, "assay", "run an assay with trained policies into rollout tables",
+                      "Run the configured assay (assay=NAME) with the policies of --policy: each condition's "
+                      "episodes, recorded as steps, episodes, food and conditions tables (and hidden where the assay "
+                      "records hidden states). Writes <table>.parquet, config.yaml and provenance.json to --out.",
+                      "docs/methods/assays.md", "docs/reference/tables.md")
+    add_overrides(asy, example="assay=patchy4 scale=smoke")
     asy.add_argument("--policy", nargs="+", required=True, metavar="[NAME=]PATH",
                      help="training folder, final.pt or checkpoint.pt of each policy the conditions act with "
                           "(NAME: selected, homing, homing_raycast, ...; a bare PATH is the assay's own policy)")
-    asy.add_argument("--out", type=Path, help="output folder (default results/{run}/assays/{assay})")
+    _add_out(asy, "output folder (default results/{run}/assays/{assay})")
     asy.set_defaults(handler=_assay)
-    sch = sub.add_parser("schema", help="print the columns of a rollout table with their meaning")
-    sch.add_argument("table", choices=("steps", "episodes", "food", "hidden", "conditions"))
-    sch.add_argument("overrides", nargs="*")
-    sch.set_defaults(handler=_schema)
-    sel = sub.add_parser("select",
-                         help="rank seeds from their evaluation episodes (docs/methods/training.md#seed-selection)")
-    sel.add_argument("overrides", nargs="*", help="config overrides, recorded in config.yaml (e.g. scale=laptop)")
-    sel.add_argument("--episodes", nargs="+", type=Path, required=True,
-                     help="episodes.parquet files in folders named seed_<n>")
-    sel.add_argument("--out", type=Path, required=True, help="folder for ranking.parquet and selected_seed.txt")
-    sel.set_defaults(handler=_select)
-    st = sub.add_parser("stack-seeds", help="stack the top seeds' tables (each under seed_<n>/) into one table")
-    st.add_argument("overrides", nargs="*")
-    st.add_argument("--tables", nargs="+", type=Path, required=True, help="the seeds' tables, each under seed_<n>/")
-    st.add_argument("--ranking", type=Path, required=True, help=f"the seed ranking ({RANKING})")
-    st.add_argument("--out", type=Path, required=True, help="the stacked table (.parquet)")
-    st.set_defaults(handler=_stack_seeds)
-    an = sub.add_parser("analyze", help="run one analysis (efish.analysis.registry) on an assay's rollout tables")
+    an = add_command(sub, "analyze", "run one analysis of an assay's rollout tables",
+                     "Run one analysis (efish.analysis.registry) of an assay's rollout tables under the config's "
+                     "analysis settings. Writes its <table>.parquet files, analysis_settings.parquet, config.yaml and "
+                     "provenance.json to --out.", "docs/methods/analyses.md", "docs/tutorials/add-an-analysis.md")
     an.add_argument("name", help="an analysis of efish.analysis.registry, e.g. behaviour (a wrong name lists them)")
-    an.add_argument("overrides", nargs="*", help="config overrides, e.g. assay=patchy4 analysis.rate_bins=10")
+    add_overrides(an, example="assay=patchy4 analysis.rate_bins=10")
     an.add_argument("--tables", type=Path, required=True,
                     help="folder of the assay's tables (steps.parquet, ..., conditions.parquet: what it simulated)")
-    an.add_argument("--out", type=Path, required=True,
-                    help="folder for <table>.parquet, analysis_settings.parquet (the analysis settings it ran with), "
-                         "config.yaml, provenance.json")
+    _add_out(an, "folder for <table>.parquet, analysis_settings.parquet (the analysis settings it ran with), "
+                 "config.yaml, provenance.json", required=True)
     an.set_defaults(handler=_analyze)
-    sc = sub.add_parser("scene", help="compute a scene's field maps (config/scene/<name>.yaml) into a table")
+    sc = add_command(sub, "scene", "compute a scene's field maps into a table",
+                     "Compute the field maps of a scene (config/scene/NAME.yaml) on its grid with the physics, for "
+                     "Fig 1 and the sensing-range panels. Writes NAME.parquet, config.yaml and NAME.provenance.json "
+                     "to --out.", "docs/methods/figures.md#panels")
     sc.add_argument("name", help="a scene of config/scene/, e.g. eod_walls")
-    sc.add_argument("overrides", nargs="*", help="config overrides, e.g. scene.resolution_cm=1")
-    sc.add_argument("--out", type=Path, help="folder for <name>.parquet (default results/{run}/scenes)")
+    add_overrides(sc, example="scene.resolution_cm=1")
+    _add_out(sc, "folder for <name>.parquet (default results/{run}/scenes)")
     sc.set_defaults(handler=_scene)
-    fg = sub.add_parser("figure", help="draw a panel (fig3/M) or a whole figure's page (fig3) from the tables")
+
+
+def _figure_commands(sub: argparse._SubParsersAction) -> None:
+    """Drawing from the result tables: figure, render, contact-sheet."""
+    fg = add_command(sub, "figure", "draw a panel or a figure's page from the result tables",
+                     "Draw one panel (fig3/M), or each panel of a figure and its page (fig3), from a run's result "
+                     "tables; bench/accuracy and bench/scaling redraw a benchmark's figure. Writes PNG and PDF files, "
+                     "each with its provenance, and config.yaml to --out.", "docs/methods/figures.md")
     fg.add_argument("key", help="panel id like fig3/M, a figure id like fig3 for its page, or bench/accuracy, "
                                 "bench/scaling (a benchmark's figure, from results/{run}/bench/bench_<name>.parquet)")
-    fg.add_argument("overrides", nargs="*")
+    add_overrides(fg, example="scale=smoke")
     fg.add_argument("--results", type=Path, help="folder of the result tables (default results/{run})")
-    fg.add_argument("--out", type=Path, help="folder for the figures (default figures/{run}; a benchmark's figure "
-                                             "goes to its bench/)")
+    _add_out(fg, "folder for the figures (default figures/{run}; a benchmark's figure goes to its bench/)")
     fg.set_defaults(handler=_figure)
-    rd = sub.add_parser("render", help="draw one episode of an assay as a clip (.gif; .mp4 with ffmpeg)")
-    rd.add_argument("overrides", nargs="*", help="config overrides; assay=<name> names the assay (e.g. homing)")
+    rd = add_command(sub, "render", "draw one episode of an assay as a clip",
+                     "Draw one episode of an assay (assay=NAME) from its rollout tables as a clip, .gif or (with "
+                     "ffmpeg) .mp4, optionally over the field of the discharges. Writes the clip, config.yaml and "
+                     "<clip>.provenance.json.", "docs/tutorials/render-an-episode.md",
+                     "docs/methods/figures.md#episode-clips")
+    add_overrides(rd, example="assay=homing scale=smoke", note="assay=NAME names the assay")
     rd.add_argument("--condition", help="condition to draw (default: the assay's first)")
     rd.add_argument("--episode", type=int, help="episode to draw (default: the condition's first)")
     rd.add_argument("--tables", type=Path, help="folder of the assay's tables (default results/{run}/assays/{assay})")
-    rd.add_argument("--out", type=Path, help="the clip, .gif or .mp4 (default figures/{run}/clips/{assay}.gif)")
+    _add_out(rd, "the clip, .gif or .mp4 (default figures/{run}/clips/{assay}.gif)")
     rd.add_argument("--every", type=int, help="draw every N-th step (default: the smallest N that plays in real "
                                               "time and keeps the clip a few MB)")
     rd.add_argument("--fps", type=float, help="frames per second (default env.fps / N: real time)")
     rd.add_argument("--field", action="store_true", help="overlay |E| of the EODs discharged at each step "
                                                          "(computed by the physics on a coarse grid)")
     rd.set_defaults(handler=_render)
-    cs = sub.add_parser("contact-sheet", help="every registered panel's PNG as a thumbnail with its id")
-    cs.add_argument("overrides", nargs="*")
+    cs = add_command(sub, "contact-sheet", "every registered panel's PNG as a thumbnail with its id",
+                     "Lay out each registered panel's PNG of a run as a thumbnail with its id, marking the panels not "
+                     "drawn at this scale. Writes one PNG with its config.yaml and provenance.",
+                     "docs/methods/figures.md#contact-sheet")
+    add_overrides(cs, example="scale=smoke")
     cs.add_argument("--figures", type=Path, help="figure folder of the run (default figures/{run})")
-    cs.add_argument("--out", type=Path, help=f"the sheet, a .png (default <figures>/{CONTACT_SHEET})")
+    _add_out(cs, f"the sheet, a .png (default <figures>/{CONTACT_SHEET})")
     cs.set_defaults(handler=_contact_sheet)
-    cl = sub.add_parser("claims", help="the paper's claims (docs/claims/index.md) as verdicts from a run's tables")
-    cl.add_argument("overrides", nargs="*", help="config overrides, e.g. scale=smoke analysis.claims_resamples=200")
+
+
+def _claims_commands(sub: argparse._SubParsersAction) -> None:
+    """The paper's claims as verdicts, along training and across runs: claims, claims-by-stage, compare-claims."""
+    cl = add_command(sub, "claims", "the paper's claims as verdicts from a run's tables",
+                     "Test the paper's claims on a run's result tables under the nine rules and give each a verdict. "
+                     "Writes claims.parquet, claim_parts.parquet (a row per part) and claims.md to --out; with the "
+                     "other top seeds' claims also seed_verdicts and seeds_agree.", "docs/claims/index.md",
+                     "docs/claims/results.md")
+    add_overrides(cl, example="scale=smoke analysis.claims_resamples=200")
     cl.add_argument("--results", type=Path, help="the run's results folder (default results/{run})")
-    cl.add_argument("--out", type=Path, help="folder for claims.parquet and claims.md (default <results>/claims)")
+    _add_out(cl, "folder for claims.parquet and claims.md (default <results>/claims)")
     cl.add_argument("--seed-claims", nargs="*", metavar="SEED=PATH",
                     help="the claims.parquet of each other top seed (results/{run}/seeds/seed_<n>/claims/): adds "
                          "seed_verdicts and seeds_agree; given with no value, the selected seed's "
@@ -185,9 +292,18 @@ def _parser() -> argparse.ArgumentParser:
     cl.add_argument("--trends", type=Path, help="a claims_trends.parquet (efish claims-by-stage): claims.md gains an "
                                                 "'Along training' section, one line per claim")
     cl.set_defaults(handler=run_claims)
-    cbs = sub.add_parser("claims-by-stage", help="the claims' parts at the kept training stages, and whether each is "
-                                                 "still moving (a table, the trends, a figure)")
-    cbs.add_argument("overrides", nargs="*", help="config overrides (analysis.claims_trend_alpha; the run's name)")
+    _claims_by_stage_command(sub)
+    _compare_claims_command(sub)
+
+
+def _claims_by_stage_command(sub: argparse._SubParsersAction) -> None:
+    """``efish claims-by-stage``: the claims' parts at the kept training stages."""
+    cbs = add_command(sub, "claims-by-stage", "the claims' parts at the kept training stages, and their trends",
+                      "Stack the claims' parts at the kept training stages and test whether each is still moving. "
+                      "Writes claims_by_stage.parquet and claims_trends.parquet (--out), claims.md with a line per "
+                      "claim along training (--claims) and claims_by_stage.png and .pdf (--figures).",
+                      "docs/claims/along-training.md")
+    add_overrides(cbs, example="scale=laptop analysis.claims_trend_alpha=0.01", note="they name the run")
     cbs.add_argument("--stages", nargs="+", required=True, metavar="K=PATH",
                      help="each stage's claim_parts.parquet, its claims folder, or its results folder "
                           "(results/{run}/learning/stage_<k>)")
@@ -201,12 +317,19 @@ def _parser() -> argparse.ArgumentParser:
                                                  "claims.md beside the tables with one line per claim along training")
     cbs.add_argument("--episodes", nargs="+", metavar="K=N",
                      help="episodes per condition the stage's assays ran (adds an episodes column)")
-    cbs.add_argument("--out", type=Path, help="folder for claims_by_stage.parquet and claims_trends.parquet "
-                                              f"(default results/{{run}}/{Path(CLAIMS_BY_STAGE).parent})")
+    _add_out(cbs, "folder for claims_by_stage.parquet and claims_trends.parquet "
+                  f"(default results/{{run}}/{Path(CLAIMS_BY_STAGE).parent})")
     cbs.add_argument("--figures", type=Path, help="folder for claims_by_stage.png and .pdf "
                                                   f"(default figures/{{run}}/{Path(CLAIMS_BY_STAGE_FIGURE).parent})")
     cbs.set_defaults(handler=run_claims_by_stage)
-    cc = sub.add_parser("compare-claims", help="two or more runs' claim verdicts and effect sizes side by side")
+
+
+def _compare_claims_command(sub: argparse._SubParsersAction) -> None:
+    """``efish compare-claims``: runs' verdicts side by side."""
+    cc = add_command(sub, "compare-claims", "two or more runs' claim verdicts and effect sizes side by side",
+                     "Print two or more runs' claim verdicts, seeds_agree and effect sizes side by side (with --sweep, "
+                     "a sweep's runs). Writes a claims x runs table (--out) and heatmap (--heatmap) when asked.",
+                     "docs/tutorials/compare-claims.md", "docs/tutorials/sweep-a-parameter.md")
     cc.add_argument("runs", nargs="*", metavar="RUN",
                     help="claims.parquet, a claims folder, or a run name (results/<name>/claims/claims.parquet); two "
                          "or more in all, with --sweep's")
@@ -216,75 +339,116 @@ def _parser() -> argparse.ArgumentParser:
     cc.add_argument("--overrides", default="", help="the sweep's run overrides (--config overrides=)")
     cc.add_argument("--results", type=Path, default=RESULTS_ROOT,
                     help="where a run name's folder is (default results/)")
-    cc.add_argument("--out", type=Path, help="write the claims x runs table (each run's recipe verdict and effect "
-                                             "where it has them, its verdict and effect) as .parquet or .csv")
+    _add_out(cc, "write the claims x runs table (each run's recipe verdict and effect where it has them, its verdict "
+                 "and effect) as .parquet or .csv")
     cc.add_argument("--heatmap", type=Path, help="draw the claims x runs heatmap as a PNG (cell colour: each run's "
                                                  "recipe verdict, else its verdict; text: that effect)")
     cc.set_defaults(handler=run_compare_claims)  # no overrides: nothing to compose
-    pc = sub.add_parser("plan-cluster", help="expected runtime, memory and cores of every job of a scale, checked "
-                                             "against a SLURM profile")
-    pc.add_argument("overrides", nargs="*", help="the scale to plan and its overrides, e.g. scale=paper")
+
+
+def _cluster_commands(sub: argparse._SubParsersAction) -> None:
+    """Planning a run on a SLURM cluster from a measured one: plan-cluster."""
+    pc = add_command(sub, "plan-cluster", "every job of a scale with runtime, memory and cores, against a profile",
+                     "Scale the benchmark files of a measured run (--from) to every job of another scale "
+                     "(scale=paper): the expected runtime, memory and cores of each, checked against a SLURM "
+                     "profile. Writes nothing; --suggest prints set-resources for the profile.",
+                     "docs/getting-started.md#slurm", "docs/benchmarks.md#pipeline")
+    add_overrides(pc, example="scale=paper", note="the scale to plan")
     pc.add_argument("--from", dest="source", default="laptop", help="scale whose run was measured (default laptop)")
     pc.add_argument("--results", type=Path, help="results folder of that run (default results/<--from>)")
-    pc.add_argument("--profile", type=Path, default=Path("workflow/profiles/slurm"), help="profile to check")
+    pc.add_argument("--profile", type=Path, default=Path("workflow/profiles/slurm"),
+                    help="the Snakemake profile whose resources are checked (default workflow/profiles/slurm)")
     pc.add_argument("--dry-run", type=Path, help="a saved `snakemake -n --forceall` output instead of running it")
-    pc.add_argument("--json", action="store_true", help="print JSON records instead of a table")
+    _add_json(pc)
     pc.add_argument("--suggest", action="store_true", help="also print set-resources covering the headroom")
     pc.set_defaults(handler=_plan_cluster)
-    _bench_parsers(sub.add_parser("bench", help="speed and accuracy studies (sizes: the bench.* config fields)"))
-    return p
 
 
-def _bench_parsers(b: argparse.ArgumentParser) -> None:
+# efish bench <study>: (summary, description) of each study; each cites its section of docs/benchmarks.md
+BENCH_STUDIES = {
+    "physics": ("sensing throughput: fast path vs reference, one thread",
+                "Time the sensing of a step, the fast path against the reference, on one thread. Prints a table "
+                "(or JSON); --out also writes bench_physics.json with config.yaml and provenance.json."),
+    "env": ("env-only throughput with random actions: fast path vs reference",
+            "Time stepping the environment with random actions, fast physics against the reference. Prints a "
+            "table (or JSON); writes nothing."),
+    "train": ("rollout/update speed and model-FLOP utilisation",
+              "Time the rollout and the update of training at each network width, and their model-FLOP "
+              "utilisation, on the paper's training arenas. Prints a table (or JSON); writes nothing."),
+    "budget": ("at fixed training time: a wider network, more env steps or more seeds",
+               "Train runs of a fixed wall time: is a wider network, more env steps or more seeds worth it? Prints a "
+               "table; --out also writes bench_budget.parquet with config.yaml and its provenance."),
+    "pipeline": ("time per rule family of a finished pipeline run",
+                 "Sum the time of each rule family of a finished pipeline run, from Snakemake's benchmark files. "
+                 "Prints a table (or JSON); writes nothing."),
+    "accuracy": ("accuracy-vs-time sweep: table and figure",
+                 "Sweep the physics' accuracy settings and measure the error each gives against its time. Writes "
+                 "bench_accuracy.parquet (--out) and its figure as PNG and PDF (--figures), each with config.yaml "
+                 "and provenance."),
+    "scaling": ("cost per agent-step against pellets and agents: table and figure",
+                "Measure the cost of an agent-step as pellets and agents are added. Writes bench_scaling.parquet "
+                "(--out) and its figure as PNG and PDF (--figures), each with config.yaml and provenance."),
+    "multipole": ("cell multipoles against direct far-field reads at the plan's accuracy",
+                  "Would cell multipoles make the far field cheaper? Compares them with direct far-field reads at "
+                  "the plan's accuracy, for each expansion order. Prints a table (or JSON); writes nothing."),
+}
+
+
+def _bench_command(bsub: argparse._SubParsersAction, name: str, *docs: str) -> argparse.ArgumentParser:
+    """``efish bench <name>`` with its help (:data:`BENCH_STUDIES`) and overrides, citing its Benchmarks section."""
+    summary, description = BENCH_STUDIES[name]
+    parser = add_command(bsub, name, summary, description, f"docs/benchmarks.md#{name}", *docs)
+    add_overrides(parser, example="scale=smoke bench.repeats=3", note="the bench.* fields are the study's sizes")
+    return parser
+
+
+def _bench_parsers(sub: argparse._SubParsersAction) -> None:
     """``efish bench <study>``: a flag left out means the config's ``bench.*`` value (one copy: the schema)."""
-    bsub = b.add_subparsers(dest="bench", required=True)
-    bp = bsub.add_parser("physics", help="sensing throughput: fast path vs reference, one thread")
-    bp.add_argument("overrides", nargs="*")
-    bp.add_argument("--json", action="store_true", help="print JSON instead of a table")
-    bp.add_argument("--out", type=Path, help="also write bench_physics.json (+ config, provenance) here")
+    b = add_command(sub, "bench", "speed and accuracy studies (sizes: the bench.* config fields)",
+                    "Speed and accuracy studies of the simulator, the environment and training. Their sizes are the "
+                    "bench.* config fields (efish config lists them); a study's flags override them for one run.",
+                    "docs/benchmarks.md")
+    bsub = b.add_subparsers(dest="bench", required=True, metavar="STUDY",
+                            help="the study to run (efish bench STUDY --help says more)")
+    bp = _bench_command(bsub, "physics")
+    _add_json(bp)
+    _add_out(bp, "also write bench_physics.json (+ config, provenance) here")
     bp.set_defaults(handler=_bench_physics)
-    be = bsub.add_parser("env", help="env-only throughput with random actions: fast path vs reference")
-    be.add_argument("overrides", nargs="*")
-    be.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    be = _bench_command(bsub, "env")
+    _add_json(be)
     be.add_argument("--envs", type=int, help="arenas stepped together (default bench.env_envs)")
     be.add_argument("--steps", type=int, help="timed steps (default bench.env_steps)")
     be.set_defaults(handler=_bench_env)
-    bt = bsub.add_parser("train", help="rollout/update speed and model-FLOP utilisation")
-    bt.add_argument("overrides", nargs="*")
-    bt.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    bt = _bench_command(bsub, "train", "docs/methods/training.md")
+    _add_json(bt)
     bt.add_argument("--hidden", type=int, nargs="+", help="widths to time (default bench.train_hidden)")
     bt.add_argument("--device", choices=("cpu", "cuda", "auto"),
                     help="where the GEMMs, the update and the rollout's networks run (default train.device; auto: "
                          "cuda where torch sees a GPU)")
     bt.set_defaults(handler=_bench_train, recipe=TRAINING_RECIPE)
-    bb = bsub.add_parser("budget", help="at fixed training time: a wider network, more env steps or more seeds")
-    bb.add_argument("overrides", nargs="*")
+    bb = _bench_command(bsub, "budget")
     bb.add_argument("--minutes", type=float, help="wall time of each run (default bench.budget_minutes)")
     bb.add_argument("--hidden", type=int, nargs="+", help="widths to train (default bench.budget_hidden)")
     bb.add_argument("--seeds", type=int, help="seeds per width (default bench.budget_seeds)")
     bb.add_argument("--jobs", type=int, help="runs at a time, one thread each (default bench.budget_jobs)")
-    bb.add_argument("--out", type=Path, help="also write bench_budget.parquet (+ config, provenance) here")
+    _add_out(bb, "also write bench_budget.parquet (+ config, provenance) here")
     bb.set_defaults(handler=_bench_budget, recipe=TRAINING_RECIPE)
-    bpl = bsub.add_parser("pipeline", help="time per rule family of a finished pipeline run")
-    bpl.add_argument("overrides", nargs="*")
+    bpl = _bench_command(bsub, "pipeline")
     bpl.add_argument("--results", type=Path, help="results folder of the run (default results/{run})")
-    bpl.add_argument("--json", action="store_true", help="print JSON records instead of a table")
+    _add_json(bpl)
     bpl.set_defaults(handler=_bench_pipeline)
-    for name, help_ in (("accuracy", "accuracy-vs-time sweep: table and figure"),
-                        ("scaling", "cost per agent-step against pellets and agents: table and figure")):
-        bf = bsub.add_parser(name, help=help_)
-        bf.add_argument("overrides", nargs="*")
-        bf.add_argument("--out", type=Path, help=f"folder for bench_{name}.parquet, config.yaml and provenance "
-                                                 "(default results/{run}/bench)")
+    for name, handler, docs in (("accuracy", _bench_accuracy, ("docs/model/accuracy.md",)),
+                                ("scaling", _bench_scaling, ())):
+        bf = _bench_command(bsub, name, *docs)
+        _add_out(bf, f"folder for bench_{name}.parquet, config.yaml and provenance (default results/{{run}}/bench)")
         bf.add_argument("--figures", type=Path, help=f"folder for bench_{name}.png and .pdf (default "
                                                      "figures/{run}/bench)")
-        bf.add_argument("--json", action="store_true", help="print the table as JSON records")
-        bf.set_defaults(handler=_bench_accuracy if name == "accuracy" else _bench_scaling)
-    bm = bsub.add_parser("multipole", help="cell multipoles against direct far-field reads at the plan's accuracy")
-    bm.add_argument("overrides", nargs="*")
+        _add_json(bf)
+        bf.set_defaults(handler=handler)
+    bm = _bench_command(bsub, "multipole")
     bm.add_argument("--orders", type=int, nargs="+", help="expansion orders (default bench.multipole_orders)")
     bm.add_argument("--width", type=float, help="square arena side of the scene, cm (default bench.multipole_width_cm)")
-    bm.add_argument("--json", action="store_true", help="print the table as JSON records")
+    _add_json(bm)
     bm.set_defaults(handler=_bench_multipole)
 
 

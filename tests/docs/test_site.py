@@ -88,6 +88,14 @@ def test_the_cli_reference_has_every_command_with_its_help():
     commands = next(a for a in _parser()._actions if hasattr(a, "choices") and isinstance(a.choices, dict)).choices
     for name, sub in commands.items():
         assert f"## `efish {name}`" in text and sub.format_usage().split()[1] in text, name
+    assert "### `efish bench physics` {#bench-physics}" in text  # a study under its command
+    assert "Read: [Claims › Rules and claims](docs/claims/index.md); [Claims › Results](docs/claims/results.md)." in text
+
+
+def test_a_markdown_link_to_a_docs_page_keeps_its_title_and_gets_a_relative_target():
+    text = "Read: [Claims › Results](docs/claims/results.md#stability); bare docs/benchmarks.md.\n"
+    out = HOOKS.link_docs(text, "reference/cli.md")
+    assert out == "Read: [Claims › Results](../claims/results.md#stability); bare [benchmarks](../benchmarks.md).\n"
 
 
 def test_math_becomes_mathml_outside_code_only():

@@ -14,6 +14,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
+import efish
 from efish.analysis.selection import RANKING_COLUMNS
 from efish.bench.accuracy import COLUMNS
 from efish.claims.recipe import RECIPE_PART_COLUMNS
@@ -87,6 +88,7 @@ def test_every_output_folder_has_config_and_provenance(smoke_run):
 def check_provenance(path: Path) -> None:
     prov = json.loads(path.read_text())
     assert prov["command"] and prov["finished"] >= prov["started"], path
+    assert prov["efish_version"] == efish.__version__, path
     assert "scale=smoke" in prov["overrides"], path
 
 
