@@ -129,7 +129,7 @@ def test_every_top_level_module_has_a_layer():
 
 @pytest.mark.parametrize("modules", [
     ["efish"],
-    ["efish.figures.registry", "efish.figures.render"],
+    ["efish.figures.registry", "efish.figures.render", "efish.figures.gallery"],
     ["efish.analysis." + p.stem for p in sorted((PACKAGE / "analysis").glob("*.py")) if p.stem != "__init__"],
     ["efish.claims." + p.stem for p in sorted((PACKAGE / "claims").glob("*.py")) if p.stem != "__init__"],
     ["efish.config", "efish.rollout.schema"],

@@ -15,6 +15,8 @@
     efish render assay=NAME [overrides] [--condition C] [--episode K] [--out F.gif|F.mp4] [--field]
                                               one episode of an assay as a clip, from its rollout tables
     efish contact-sheet [overrides] [--figures D] [--out F.png]   every panel's PNG as a thumbnail with its id
+    efish gallery RUN [--figures D] [--results D] [--out D] [--max-width PX]   every panel of a run, web-sized,
+                                              with its caption on one page -> docs/gallery/index.md and img/
     efish claims [overrides] [--results D] [--out D] [--ranking F] [--seed-claims SEED=F ...] [--trends F]
                                               the paper's claims as verdicts -> claims.parquet, claim_parts.parquet
                                               (one row per part), claims.md; with the other top seeds' claims
@@ -73,12 +75,14 @@ from ._version import __version__
 from .cli_claims import run_claims, run_claims_by_stage, run_compare_claims
 from .cli_support import HelpFormatter, add_command, add_overrides, run_of, see_docs, write_metadata
 from .config import ConfigError, compose, to_yaml
+from .figures.gallery import GALLERY, MAX_WIDTH_PX
 from .layout import (
     ANALYSIS_SETTINGS,
     BENCH,
     CLAIMS_BY_STAGE,
     CLAIMS_BY_STAGE_FIGURE,
     CONTACT_SHEET,
+    FIGURES_ROOT,
     RANKING,
     RESULTS_ROOT,
     SELECTED_SEED,
@@ -270,6 +274,21 @@ def _figure_commands(sub: argparse._SubParsersAction) -> None:
     cs.add_argument("--figures", type=Path, help="figure folder of the run (default figures/{run})")
     _add_out(cs, f"the sheet, a .png (default <figures>/{CONTACT_SHEET})")
     cs.set_defaults(handler=_contact_sheet)
+    ga = add_command(sub, "gallery", "every registered panel of a run on one Markdown page (the site's gallery)",
+                     "Copy every registered panel of a run, web-sized, onto one Markdown page grouped by figure, each "
+                     "with its caption, a panel the run did not draw saying why, and the commits, CPU and torch CPU "
+                     "capability the run recorded. Writes <out>/index.md and <out>/img/.", "docs/methods/figures.md#gallery")
+    ga.add_argument("run", help="the run's name (laptop, smoke, laptop-453280a3): the page's title and its folders' "
+                                "default names")
+    ga.add_argument("--figures", type=Path, help="the run's figure folder, whose <figure>/<panel>.png it copies "
+                                                 "(default figures/<run>)")
+    ga.add_argument("--results", type=Path, help="the run's results folder: the commits of its tables' provenance "
+                                                 "and the CPU of bench/bench_physics.json (default results/<run>)")
+    ga.add_argument("--out", type=Path, default=GALLERY, help=f"folder for index.md and the images under img/ "
+                                                              f"(default {GALLERY})")
+    ga.add_argument("--max-width", type=int, default=MAX_WIDTH_PX,
+                    help=f"widest image in pixels: wider PNGs are scaled down (default {MAX_WIDTH_PX})")
+    ga.set_defaults(handler=_gallery)  # no overrides: nothing to compose
 
 
 def _claims_commands(sub: argparse._SubParsersAction) -> None:
@@ -655,6 +674,18 @@ def _contact_sheet(args, cfg, started) -> None:
     drawn, absent = write_contact_sheet(figures, out)
     write_metadata(out.parent, cfg, started, args, name=f"{out.stem}.provenance.json", figures=str(figures))
     print(f"wrote {out} (panels drawn: {drawn}; not drawn at this scale: {absent})")
+
+
+def _gallery(args, cfg, started) -> None:
+    from .figures.gallery import write_gallery
+
+    # the page names the command that regenerates it: the run and the options that differ from their defaults
+    given = {"--figures": (args.figures, FIGURES_ROOT / args.run), "--results": (args.results, RESULTS_ROOT / args.run),
+             "--out": (args.out, GALLERY), "--max-width": (args.max_width, MAX_WIDTH_PX)}
+    command = " ".join(["efish gallery", args.run, *(f"{flag} {value}" for flag, (value, default) in given.items()
+                                                     if value is not None and value != default)])
+    drawn, absent = write_gallery(args.run, args.figures, args.results, args.out, args.max_width, command)
+    print(f"wrote {args.out / 'index.md'} and its images (panels drawn: {drawn}; not drawn in this run: {absent})")
 
 
 def _plan_cluster(args, cfg, started) -> None:
