@@ -168,9 +168,10 @@ def test_efish_claims_by_stage_writes_the_stacked_table_the_trends_and_the_figur
     trends = pd.read_parquet(out / "claims_trends.parquet").set_index("claim")
     assert trends.loc["C3", "trend"] == "moving toward the paper's sign" and trends.loc["C9", "trend"] == "stable"
     assert {"config.yaml", "claims_by_stage.provenance.json"} <= {p.name for p in out.iterdir()}
-    assert (figures / "claims_by_stage.png").is_file() and (figures / "claims_by_stage.pdf").is_file()
+    for group in ("fig2", "fig3", "fig4", "fig5", "fig6"):  # one figure per figure of the paper's claims
+        assert (figures / f"claims_by_stage_{group}.png").is_file() and (figures / f"claims_by_stage_{group}.pdf").is_file()
     text = capsys.readouterr().out
-    assert text.startswith("C3 (alignment): moving toward the paper's sign") and "claims_by_stage.png" in text
+    assert text.startswith("C3 (alignment): moving toward the paper's sign") and "claims_by_stage_fig3.png" in text
 
 
 def test_efish_claims_by_stage_reads_env_steps_from_the_stage_files_and_writes_the_claims_page(tmp_path):

@@ -27,8 +27,8 @@
                                               the claims' parts at the kept training stages stacked, each part's
                                               trend -> claims_by_stage.parquet, claims_trends.parquet (--out,
                                               default results/<run>/learning), claims.md with the trend lines
-                                              (--claims) and claims_by_stage.png|pdf (--figures, default
-                                              figures/<run>/learning)
+                                              (--claims) and claims_by_stage_<fig>.png|pdf, one per figure
+                                              of claims, fig2 .. fig6 (--figures, default figures/<run>/learning)
     efish compare-claims A B                  two runs' claim verdicts, seeds_agree and effects side by side
     efish compare-claims A B C --heatmap H.png  claims x runs: a table (--out) and a heatmap
     efish scene NAME [overrides] --out D      field maps of config/scene/NAME.yaml -> D/NAME.parquet
@@ -338,8 +338,9 @@ def _claims_by_stage_command(sub: argparse._SubParsersAction) -> None:
                      help="episodes per condition the stage's assays ran (adds an episodes column)")
     _add_out(cbs, "folder for claims_by_stage.parquet and claims_trends.parquet "
                   f"(default results/{{run}}/{Path(CLAIMS_BY_STAGE).parent})")
-    cbs.add_argument("--figures", type=Path, help="folder for claims_by_stage.png and .pdf "
-                                                  f"(default figures/{{run}}/{Path(CLAIMS_BY_STAGE_FIGURE).parent})")
+    cbs.add_argument("--figures", type=Path, help="folder for claims_by_stage_<fig>.png and .pdf, one per figure "
+                                                  "of the paper's claims (fig2 .. fig6) (default "
+                                                  f"figures/{{run}}/{Path(CLAIMS_BY_STAGE_FIGURE).parent})")
     cbs.set_defaults(handler=run_claims_by_stage)
 
 

@@ -19,7 +19,8 @@ its tables under ``results/<run>/`` and its drawings under ``figures/<run>/``::
       bench/                          benchmark tables
       logs/, benchmarks/              one .log and one Snakemake .tsv per job
     figures/<run>/
-      <figure>/<panel>.png|pdf, <figure>.png|pdf, clips/<assay>.gif, contact_sheet.png, bench/
+      <figure>/<panel>.png|pdf, <figure>.png|pdf, clips/<assay>.gif, contact_sheet.png, bench/,
+      learning/claims_by_stage_<figure>.png|pdf (the claims along training, one per figure of claims)
 
 Panels and claims name a table by its path relative to ``results/<run>/`` (``assays/patchy4/steps.parquet``);
 the functions below build those names and :func:`parse_table` reads them back. :class:`Run` anchors them in a
@@ -245,9 +246,21 @@ class Run:
 CLAIM_PARTS = "claims/claim_parts.parquet"  # one row per part of each claim, beside claims.parquet
 RECIPE_PARTS = "claims/recipe_parts.parquet"  # each part decided over the top seeds (efish.claims.recipe)
 #: The claims along training (``efish claims-by-stage``): the stages' parts stacked and each part's trend, under
-#: ``results/<run>/``, and their figure (``.png``, ``.pdf``) under ``figures/<run>/``.
+#: ``results/<run>/``, and their figures (``.png``, ``.pdf``) under ``figures/<run>/``.
 CLAIMS_BY_STAGE = f"{LEARNING}/claims_by_stage.parquet"
 CLAIMS_TRENDS = f"{LEARNING}/claims_trends.parquet"
 #: The selected seed's claims page with one line per claim along training (its trend over the stages).
 CLAIMS_TRENDS_PAGE = f"{LEARNING}/claims.md"
+#: The claims along training's figures are one per figure of the paper's claims, ``claims_by_stage_<group>``
+#: (:func:`claims_by_stage_stem`; the groups: ``efish.claims.registry.CLAIM_FIGURES``).
 CLAIMS_BY_STAGE_FIGURE = f"{LEARNING}/claims_by_stage"
+
+
+def claims_by_stage_stem(group: str) -> str:
+    """The stem, under ``figures/<run>/``, of the claims along training's figure of ``group`` (``fig3``); it is
+    written as ``.png`` and ``.pdf``.
+
+    >>> claims_by_stage_stem("fig3")
+    'learning/claims_by_stage_fig3'
+    """
+    return f"{CLAIMS_BY_STAGE_FIGURE}_{group}"

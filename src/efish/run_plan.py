@@ -28,7 +28,7 @@ from pathlib import Path
 
 from ._numba_cache import source_digest
 from .analysis.registry import Analysis, analyses_for, tables_written
-from .claims.registry import claim_tables, produced_tables
+from .claims.registry import CLAIM_FIGURES, claim_tables, produced_tables
 from .config import ConfigError, compose, config_dir, run_name
 from .config.schema import AssayConfig, EfishConfig
 from .env.observe import observation_size
@@ -39,7 +39,6 @@ from .io import read_parquet, write_text_atomic
 from .layout import (
     CLAIM_PARTS,
     CLAIMS_BY_STAGE,
-    CLAIMS_BY_STAGE_FIGURE,
     CLAIMS_PAGE,
     CLAIMS_TABLE,
     CLAIMS_TRENDS,
@@ -50,6 +49,7 @@ from .layout import (
     analysis_table,
     assay_table,
     bench_file,
+    claims_by_stage_stem,
     seed_name,
     stacked_seeds_table,
     training_file,
@@ -240,11 +240,13 @@ def analysis_outputs(analysis: Analysis, run: Run, assay: str = "{assay}") -> di
 
 
 def learning_outputs(run: Run) -> dict[str, str]:
-    """What claims-by-stage writes: the stacked parts, the trends, the claims page with its trend lines, and the
-    figure (``png``, ``pdf``)."""
+    """What claims-by-stage writes: the stacked parts, the trends, the claims page with its trend lines, and one
+    figure per figure of the paper's claims (``CLAIM_FIGURES``), named ``<ext>_<figure>`` (``png_fig3``,
+    ``pdf_fig3``)."""
     tables = {"table": CLAIMS_BY_STAGE, "trends": CLAIMS_TRENDS, "page": CLAIMS_TRENDS_PAGE}
-    figure = {ext: str(run.figures / f"{CLAIMS_BY_STAGE_FIGURE}.{ext}") for ext in FIGURE_FORMATS}
-    return {name: str(run.path(path)) for name, path in tables.items()} | figure
+    figures = {f"{ext}_{group}": str(run.figures / f"{claims_by_stage_stem(group)}.{ext}")
+               for group in CLAIM_FIGURES for ext in FIGURE_FORMATS}
+    return {name: str(run.path(path)) for name, path in tables.items()} | figures
 
 
 # ------------------------------------------------------------------ the plan

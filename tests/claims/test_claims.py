@@ -29,6 +29,7 @@ from efish.analysis.signalling import fit_power_law
 from efish.analysis.stats import spearman
 from efish.claims import fig2, fig3, fig4, fig5, fig6
 from efish.claims.context import Claim
+from efish.claims.registry import CLAIM_FIGURES
 from efish.claims.report import claims_markdown, compare_claims, load_claims
 from efish.claims.statistics import bootstrap_ci
 from efish.claims.verdicts import PART_COLUMNS, ROW_COLUMNS, combined_verdict, judge, part_rows
@@ -476,6 +477,10 @@ def test_every_claim_a_figure_module_defines_is_registered_once_under_its_figure
         assert cl.CLAIMS[c.id] is c and name == c.id.lower()
         # fig5's module holds the claims of Fig 5: the panel's figure number is the module's
         assert c.compute.__module__ == f"efish.claims.fig{c.panel[0]}", (c.id, c.panel)
+    # the groups of the claims along training's figures: each claim once, under the module that defines it
+    figure_of = {cid: figure for figure, ids in CLAIM_FIGURES.items() for cid in ids}
+    assert list(figure_of) == list(cl.CLAIMS) and list(CLAIM_FIGURES) == [f"fig{n}" for n in range(2, 7)]
+    assert all(cl.CLAIMS[cid].compute.__module__ == f"efish.claims.{f}" for cid, f in figure_of.items())
 
 
 @pytest.mark.parametrize("cid", list(BUILDERS))

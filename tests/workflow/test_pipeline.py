@@ -486,5 +486,6 @@ def test_the_learning_target_runs_the_claims_at_each_kept_stage(smoke_run, tmp_p
     assert len(last) == len(own) and set(last["claim"]) == set(own["claim"])
     assert set(pd.read_parquet(learning / "claims_trends.parquet")["claim"]) <= set(stacked["claim"])
     assert "Along training" in (learning / "claims.md").read_text()
-    for ext in ("png", "pdf"):
-        assert (work / f"figures/smoke/learning/claims_by_stage.{ext}").stat().st_size > 0
+    for group in ("fig2", "fig3", "fig4", "fig5", "fig6"):
+        for ext in ("png", "pdf"):
+            assert (work / f"figures/smoke/learning/claims_by_stage_{group}.{ext}").stat().st_size > 0

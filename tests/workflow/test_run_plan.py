@@ -195,6 +195,9 @@ def test_the_study_scale_learns_along_training_and_the_laptop_scale_does_not(pla
                                       str(run.path(CLAIM_PARTS))]
     assert study.stage_args == "scale=study scale.max_episodes=8"
     assert set(study.stages.targets(run)) <= set(study.targets(run))
+    # one figure per figure of the paper's claims (efish.claims.registry.CLAIM_FIGURES)
+    assert [t for t in study.stages.targets(run) if t.startswith("figures/")] == [
+        f"figures/study/learning/claims_by_stage_fig{n}.{ext}" for n in range(2, 7) for ext in ("png", "pdf")]
     with pytest.raises(PlanError, match=r"^the learning target needs scale.keep_stages"):
         laptop.stages.targets(Run("laptop"))
     assert not any("/learning/" in t for t in laptop.targets(Run("laptop")))

@@ -248,11 +248,12 @@ def learning_target(wildcards):
 
 
 def learning_outputs(reported=False):
-    """What claims-by-stage writes (efish.run_plan.learning_outputs); ``reported``: the figure's PNG goes into the
-    report, beside the claims."""
+    """What claims-by-stage writes (efish.run_plan.learning_outputs); ``reported``: each figure's PNG (one per
+    figure of the paper's claims) goes into the report, beside the claims."""
     outputs = run_plan.learning_outputs(RULE_RUN)
     if reported:
-        outputs["png"] = report(outputs["png"], caption="../report/learning.rst", category="Claims")
+        for name in [n for n in outputs if n.startswith("png_")]:
+            outputs[name] = report(outputs[name], caption="../report/learning.rst", category="Claims")
     return outputs
 
 

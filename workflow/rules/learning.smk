@@ -2,7 +2,8 @@
 # training stage (efish.run_plan: RunPlan.stages) the selected seed's stage_<k>.pt acts in every claim's assay,
 # the claims' analyses run on them (analysis.smk: stage_analysis_<analysis>) and the claims table is written, all in
 # results/{run}/learning/stage_<k>/ (efish.layout.Run.stage). efish claims-by-stage stacks the stages' parts
-# (a last stage at fraction 1 is the run's own claims), tests each part's trend against env steps and draws them.
+# (a last stage at fraction 1 is the run's own claims), tests each part's trend against env steps and draws them,
+# one figure per figure of the paper's claims (claims_by_stage_fig2 .. _fig6).
 
 
 use rule assay as stage_assay with:
@@ -64,7 +65,7 @@ rule claims_by_stage:
         policies=lambda wildcards, input: run_plan.keyed(KEPT_STAGES, input.policies),
         episodes=of_plan(lambda plan: run_plan.keyed(plan.stages.kept, plan.stages.episodes)),
         out=folder_of("table"),
-        figures=folder_of("png"),
+        figures=folder_of("png_fig2"),
     conda:
         "../envs/efish.yaml"
     shell:

@@ -16,16 +16,21 @@ from ..layout import analysis_table, assay_table
 from . import fig2, fig3, fig4, fig5, fig6
 from .context import Claim
 
-__all__ = ["CLAIMS", "claim_tables", "produced_tables"]
+__all__ = ["CLAIMS", "CLAIM_FIGURES", "claim_tables", "produced_tables"]
 
+_BY_FIGURE: dict[str, tuple[Claim, ...]] = {
+    "fig2": (fig2.c1, fig2.c2, fig2.c3),
+    "fig3": (fig3.c4, fig3.c5, fig3.c6, fig3.c7, fig3.c8, fig3.c9),
+    "fig4": (fig4.c10, fig4.c11, fig4.c12, fig4.c13),
+    "fig5": (fig5.c14, fig5.c15, fig5.c16),
+    "fig6": (fig6.c17, fig6.c18, fig6.c19, fig6.c20, fig6.c21),
+}
 #: Claim id -> :class:`~efish.claims.context.Claim`, in the paper's order (C1 .. C21).
-CLAIMS: dict[str, Claim] = {c.id: c for c in (
-    fig2.c1, fig2.c2, fig2.c3,
-    fig3.c4, fig3.c5, fig3.c6, fig3.c7, fig3.c8, fig3.c9,
-    fig4.c10, fig4.c11, fig4.c12, fig4.c13,
-    fig5.c14, fig5.c15, fig5.c16,
-    fig6.c17, fig6.c18, fig6.c19, fig6.c20, fig6.c21,
-)}
+CLAIMS: dict[str, Claim] = {c.id: c for claims in _BY_FIGURE.values() for c in claims}
+#: The paper's figure (the module that defines its claims: ``fig2`` .. ``fig6``) -> its claims' ids, in order: the
+#: groups of the claims along training's figures (:func:`efish.figures.learning.plot_claims_by_stage`), one figure
+#: per group. C7 (panels 3K,L and 5M,N) is figure 3's, where it is defined.
+CLAIM_FIGURES: dict[str, tuple[str, ...]] = {f: tuple(c.id for c in claims) for f, claims in _BY_FIGURE.items()}
 
 
 def claim_tables() -> list[str]:
