@@ -275,6 +275,9 @@ def link_docs(markdown: str, page_path: str) -> str:
 
 
 _STASHES: dict[str, MathStash] = {}
+#: Pages that include a file of the repository's root (``--8<--``), whose links name ``docs/<page>.md`` so that they
+#: work where the file is read on its own; on the page, at the root of docs/, the same link drops ``docs/``.
+ROOT_INCLUDES = {"changelog.md"}
 
 
 def on_page_markdown(markdown: str, page: Any, config: Any, files: Any) -> str:
@@ -284,6 +287,8 @@ def on_page_markdown(markdown: str, page: Any, config: Any, files: Any) -> str:
             raise ValueError(f"{page.file.src_path}: unknown generated part {match[1]!r} "
                              f"(known: {', '.join(GENERATED)})")
         return link_docs(GENERATED[match[1]](), page.file.src_path)
+    if page.file.src_path in ROOT_INCLUDES:  # links of a file at the repository's root, which names docs/<page>
+        markdown = markdown.replace("](docs/", "](")
     stash = _STASHES[page.file.src_path] = MathStash(len(_STASHES))
     return stash_math(MARKER.sub(generated, markdown), stash)
 
