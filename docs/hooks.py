@@ -14,6 +14,7 @@ import argparse
 import dataclasses
 import html
 import re
+from pathlib import Path
 from typing import Any
 
 from latex2mathml.converter import convert
@@ -275,20 +276,27 @@ def link_docs(markdown: str, page_path: str) -> str:
 
 
 _STASHES: dict[str, MathStash] = {}
-#: Pages that include a file of the repository's root (``--8<--``), whose links name ``docs/<page>.md`` so that they
-#: work where the file is read on its own; on the page, at the root of docs/, the same link drops ``docs/``.
-ROOT_INCLUDES = {"changelog.md"}
+REPO = Path(__file__).resolve().parents[1]
+#: Files of the repository's root that a page shows whole (``<!-- efish:changelog -->``).
+ROOT_FILES = {"changelog": "CHANGELOG.md"}
+
+
+def root_file(name: str) -> str:
+    """A root file's Markdown for a page at the root of docs/: its links name ``docs/<page>.md`` so that they work
+    where the file is read on its own (the repository), and drop ``docs/`` on the page. Only link targets change,
+    not paths quoted as code."""
+    return (REPO / ROOT_FILES[name]).read_text().replace("](docs/", "](")
 
 
 def on_page_markdown(markdown: str, page: Any, config: Any, files: Any) -> str:
     """Fill the generated parts a page asks for, then set its math aside as tokens (see :class:`MathStash`)."""
     def generated(match: re.Match) -> str:
+        if match[1] in ROOT_FILES:
+            return root_file(match[1])
         if match[1] not in GENERATED:
             raise ValueError(f"{page.file.src_path}: unknown generated part {match[1]!r} "
-                             f"(known: {', '.join(GENERATED)})")
+                             f"(known: {', '.join([*GENERATED, *ROOT_FILES])})")
         return link_docs(GENERATED[match[1]](), page.file.src_path)
-    if page.file.src_path in ROOT_INCLUDES:  # links of a file at the repository's root, which names docs/<page>
-        markdown = markdown.replace("](docs/", "](")
     stash = _STASHES[page.file.src_path] = MathStash(len(_STASHES))
     return stash_math(MARKER.sub(generated, markdown), stash)
 

@@ -184,3 +184,9 @@ def test_every_page_of_the_site_is_in_its_navigation():
     nav = (REPO / "mkdocs.yml").read_text()
     pages = {str(p.relative_to(DOCS)) for p in DOCS.rglob("*.md")}
     assert pages and all(page in nav for page in pages), sorted(p for p in pages if p not in nav)
+
+
+def test_the_changelog_page_links_the_docs_pages_the_changelog_names_and_keeps_quoted_paths():
+    text = HOOKS.root_file("changelog")
+    assert "](docs/" not in text and "](benchmarks.md)" in text
+    assert "`docs/" in (REPO / "CHANGELOG.md").read_text() and "`docs/" in text  # code keeps the repository path
