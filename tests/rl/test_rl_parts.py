@@ -139,3 +139,53 @@ def test_micro_batches_give_the_same_update_as_one_pass():
     for key in s1:
         assert s1[key] == pytest.approx(s2[key], rel=1e-4, abs=1e-6), key
     assert any(not torch.equal(a1[k], v) for k, v in actor0.state_dict().items())  # the update moved the weights
+
+
+def test_folded_input_layer_is_the_layernorm_then_the_linear():
+    """The input LayerNorm's affine part folded into the first Linear computes the same function of the same
+    parameters, with the same gradients for all four of them (to float32 rounding)."""
+    from efish.rl.networks import RecurrentTrunk
+
+    torch.manual_seed(3)
+    trunk = RecurrentTrunk(11, 8)
+    norm, first = trunk.mlp[0], trunk.mlp[1]
+    with torch.no_grad():  # away from the initial 1 and 0, so that the fold is exercised
+        norm.weight.uniform_(0.5, 2.0)
+        norm.bias.normal_()
+    x = torch.randn(5, 3, 11) * 4 + 2
+    upstream = torch.randn(5, 3, 8)
+    params = [norm.weight, norm.bias, first.weight, first.bias]
+
+    def grads(out):
+        return torch.autograd.grad((out * upstream).sum(), params)
+
+    explicit = first(norm(x))
+    folded = trunk.input_layer(trunk.standardize(x))
+    torch.testing.assert_close(folded, explicit, rtol=1e-5, atol=1e-5)
+    for a, b in zip(grads(folded), grads(explicit), strict=True):
+        torch.testing.assert_close(a, b, rtol=1e-4, atol=1e-4)
+
+
+def test_standardized_inputs_give_the_same_outputs():
+    torch.manual_seed(4)
+    actor, critic = Actor(6, 8), Critic(12, 8)
+    obs, state = torch.randn(4, 2, 6), torch.randn(4, 2, 12)
+    h, starts = torch.zeros(2, 8), torch.zeros(4, 2)
+    torch.testing.assert_close(actor(actor.trunk.standardize(obs), h, starts, standardized=True)[0].mean,
+                               actor(obs, h, starts)[0].mean)
+    torch.testing.assert_close(critic(critic.trunk.standardize(state), h, starts, standardized=True)[0],
+                               critic(state, h, starts)[0])
+
+
+def test_a_micro_batch_of_every_sequence_is_the_data_itself():
+    """A micro-batch is a set of sequences: taken in increasing order, and without a copy when it holds them all."""
+    from efish.rl.mappo import micro_batch
+
+    data = {"obs": torch.arange(24.0).reshape(2, 4, 3)}
+    h_a, h_c = torch.arange(8.0).reshape(4, 2), -torch.arange(8.0).reshape(4, 2)
+    batch, ha, hc = micro_batch(data, h_a, h_c, torch.tensor([2, 0, 3, 1]))
+    assert batch is data and ha is h_a and hc is h_c
+    batch, ha, hc = micro_batch(data, h_a, h_c, torch.tensor([3, 1]))
+    torch.testing.assert_close(batch["obs"], data["obs"][:, [1, 3]])
+    torch.testing.assert_close(ha, h_a[[1, 3]])
+    torch.testing.assert_close(hc, h_c[[1, 3]])

@@ -41,31 +41,44 @@ def chunked(x: torch.Tensor, chunk: int) -> torch.Tensor:
     return x.reshape(t // chunk, chunk, s, *x.shape[2:]).transpose(0, 1).reshape(chunk, (t // chunk) * s, *x.shape[2:])
 
 
-def micro_losses(cfg: TrainConfig, actor: Actor, critic: Critic, data: dict, h_a: torch.Tensor, h_c: torch.Tensor,
-                 idx: torch.Tensor, share: float, compute: Compute) -> dict[str, float]:
-    """Losses of the sequences ``idx``; backpropagates ``share`` x (actor loss) and ``share`` x (critic loss)
-    into the gradients, and returns the unweighted statistics. Forward passes run in ``compute``'s precision."""
+def micro_batch(data: dict[str, torch.Tensor], h_a: torch.Tensor, h_c: torch.Tensor, idx: torch.Tensor
+                ) -> tuple[dict[str, torch.Tensor], torch.Tensor, torch.Tensor]:
+    """The sequences ``idx`` of the chunked rollout ``data`` ([L, sequences, ...]) and of the chunks' initial hidden
+    states [sequences, H]. A micro-batch is a set: its losses are means over it, so the sequences are taken in
+    increasing order, and one that holds every sequence (one minibatch of one pass: the laptop scale) is the data
+    itself, without a copy of the [L, sequences, N*D] critic input per epoch."""
+    idx = idx.sort().values
+    if len(idx) == h_a.shape[0]:
+        return data, h_a, h_c
+    return {k: v.index_select(1, idx) for k, v in data.items()}, h_a[idx], h_c[idx]
+
+
+def micro_losses(cfg: TrainConfig, actor: Actor, critic: Critic, batch: dict, h_a: torch.Tensor, h_c: torch.Tensor,
+                 share: float, compute: Compute) -> dict[str, float]:
+    """Losses of a :func:`micro_batch` (its obs and state standardized, :meth:`RecurrentTrunk.standardize`);
+    backpropagates ``share`` x (actor loss) and ``share`` x (critic loss) into the gradients, and returns the
+    unweighted statistics. Forward passes run in ``compute``'s precision."""
     with compute.autocast():
-        dist, _, _ = actor(data["obs"][:, idx], h_a[idx], data["starts"][:, idx])
+        dist, _, _ = actor(batch["obs"], h_a, batch["starts"], standardized=True)
     dist = dist.to(torch.float32)
-    logp = dist.log_prob(data["actions"][:, idx])
-    ratio = torch.exp(logp - data["logp"][:, idx])
-    a = data["adv"][:, idx]
+    logp = dist.log_prob(batch["actions"])
+    ratio = torch.exp(logp - batch["logp"])
+    a = batch["adv"]
     policy_loss = -torch.min(ratio * a, ratio.clamp(1 - cfg.clip, 1 + cfg.clip) * a).mean()
     entropy = dist.entropy().mean()
     (share * (policy_loss - cfg.entropy_coef * entropy)).backward()
 
     with compute.autocast():
-        values, _ = critic(data["state"][:, idx], h_c[idx], data["starts"][:, idx])
+        values, _ = critic(batch["state"], h_c, batch["starts"], standardized=True)
     values = values.float()
-    old, tgt = data["values"][:, idx], data["targets"][:, idx]
+    old, tgt = batch["values"], batch["targets"]
     clipped = old + (values - old).clamp(-cfg.clip, cfg.clip)
     value_loss = torch.max(F.huber_loss(values, tgt, delta=cfg.huber_delta, reduction="none"),
                            F.huber_loss(clipped, tgt, delta=cfg.huber_delta, reduction="none")).mean()
     (share * cfg.value_coef * value_loss).backward()
 
     with torch.no_grad():
-        log_ratio = logp - data["logp"][:, idx]
+        log_ratio = logp - batch["logp"]
         return {"policy_loss": policy_loss.item(), "value_loss": value_loss.item(), "entropy": entropy.item(),
                 "approx_kl": float(((ratio - 1) - log_ratio).mean()),
                 "clip_fraction": float(((ratio - 1).abs() > cfg.clip).float().mean())}
@@ -81,7 +94,9 @@ def ppo_update(cfg: TrainConfig, actor: Actor, critic: Critic, actor_opt: torch.
     targets = value_norm.normalize(ro.returns)
     adv = (ro.advantages - ro.advantages.mean()) / (ro.advantages.std() + 1e-8)
     L = cfg.chunk
-    data = {k: chunked(v, L) for k, v in dict(obs=ro.obs, state=ro.state, actions=ro.actions, logp=ro.logp,
+    with torch.no_grad():  # the input LayerNorms' parameter-free part, once for all epochs
+        obs, state = actor.trunk.standardize(ro.obs), critic.trunk.standardize(ro.state)
+    data = {k: chunked(v, L) for k, v in dict(obs=obs, state=state, actions=ro.actions, logp=ro.logp,
                                                 values=ro.values, adv=adv, targets=targets, starts=ro.starts).items()}
     h_a, h_c = ro.h_actor.reshape(-1, ro.h_actor.shape[-1]), ro.h_critic.reshape(-1, ro.h_critic.shape[-1])
     n_seq = h_a.shape[0]
@@ -97,7 +112,8 @@ def ppo_update(cfg: TrainConfig, actor: Actor, critic: Critic, actor_opt: torch.
             sums = dict.fromkeys(stats, 0.0)
             for micro in idx.to(compute.device).split(cfg.micro_sequences):
                 share = len(micro) / len(idx)
-                for k, v in micro_losses(cfg, actor, critic, data, h_a, h_c, micro, share, compute).items():
+                batch, h_a_micro, h_c_micro = micro_batch(data, h_a, h_c, micro)
+                for k, v in micro_losses(cfg, actor, critic, batch, h_a_micro, h_c_micro, share, compute).items():
                     sums[k] += share * v
             torch.nn.utils.clip_grad_norm_(actor.parameters(), cfg.max_grad_norm)
             actor_opt.step()
