@@ -17,6 +17,8 @@ one for sensor noise and pellet drift.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from ..config.schema import EfishConfig
@@ -45,6 +47,15 @@ def scene_of(cfg: EfishConfig, task: Task | None = None) -> Scene:
 class VecEnv:
     """B environments with N agents each, stepped together.
 
+    ``seed`` fixes every random draw. A sequence of K seeds makes K *members*
+    of ``num_envs`` arenas each (B = K x num_envs, member k's arenas
+    ``k * num_envs`` ...): member k's arenas, their food, spawns, sizes, sensor
+    noise and pellet drift are drawn exactly as ``VecEnv(cfg, num_envs,
+    seed=seeds[k])`` draws them, so under the same actions each member steps
+    as it would alone, whatever the other members do. So several policies
+    (seeds of a recipe, on the same seeds' episodes) act in one env call, whose
+    cost per step is mostly fixed.
+
     ``reset() -> obs float32[B, N, D]``; ``step(actions float[B, N, 4])`` with
     actions (a_move, a_turn, eod, bite): a_move and a_turn are raw Gaussian
     samples mapped by sigmoid and tanh, eod and bite are 0/1. Returns
@@ -55,10 +66,15 @@ class VecEnv:
     (benchmarks and tests only, never training). The state is ``env.state``.
     """
 
-    def __init__(self, cfg: EfishConfig, num_envs: int, seed: int, autoreset: bool = True, reference: bool = False):
+    def __init__(self, cfg: EfishConfig, num_envs: int, seed: int | Sequence[int], autoreset: bool = True,
+                 reference: bool = False):
         if num_envs < 1:
             raise ValueError(f"num_envs must be >= 1, got {num_envs}")
-        self.cfg, self.num_envs, self.n = cfg, int(num_envs), cfg.env.n_agents
+        seeds = [int(seed)] if np.ndim(seed) == 0 else [int(s) for s in seed]
+        if not seeds:
+            raise ValueError("seed must be a seed or a non-empty sequence of seeds")
+        self.members, self.member_envs = len(seeds), int(num_envs)
+        self.cfg, self.num_envs, self.n = cfg, len(seeds) * int(num_envs), cfg.env.n_agents
         self.autoreset, self.reference = autoreset, reference
         self.task = make_task(cfg)
         self.plan = build_plan(cfg, scene_of(cfg, self.task))
@@ -70,10 +86,11 @@ class VecEnv:
         self.no_bite = self.bots | (not self.task.bite_allowed)
         self.ray_angles = mormyromast_angles(cfg.sensors.mormyromast)[: cfg.sensors.ray_count]
         self.perception_width = perception_width(cfg)
-        root = np.random.SeedSequence(seed)
-        children = root.spawn(num_envs + 1)
-        self.state = EnvState.empty(self.num_envs, self.n, cfg.arena, [np.random.default_rng(s) for s in children[:-1]],
-                                    np.random.default_rng(children[-1]))
+        # each member: its root seed spawns one generator per arena and one for its noise and drift
+        children = [np.random.SeedSequence(s).spawn(self.member_envs + 1) for s in seeds]
+        self.state = EnvState.empty(self.num_envs, self.n, cfg.arena,
+                                    [np.random.default_rng(c) for member in children for c in member[:-1]],
+                                    [np.random.default_rng(member[-1]) for member in children])
         self.state.task = self.task.new_state(self.num_envs)
         self._noise_u = None  # scratch for the noise draws, reused every step
         self._refresh_caches()
@@ -137,7 +154,9 @@ class VecEnv:
                 self._reset_arena(b)
             self._refresh_caches()
             self.task.goal_distance(s, s.goal_dist)
-            obs[done] = self._observe(self._forced_eod())[done]
+            # noise for the members with an ended arena only: alone, a member without one would draw none here
+            ended = sorted({self.member_of(b) for b in np.flatnonzero(done)})
+            obs[done] = self._observe(self._forced_eod(), ended)[done]
         return obs, rewards["total"], terminated, truncated, info
 
     def v_max(self) -> np.ndarray:
@@ -151,6 +170,14 @@ class VecEnv:
         """Largest turn per agent, rad (docs/model/environment.md#actions-and-motion); 0 when frozen."""
         e = self.cfg.env
         return np.where(self.frozen, 0.0, e.turn_rad_s * e.turn_gain * (1 + self.state.size) / e.fps)
+
+    def member_of(self, b: int) -> int:
+        """The member whose arena ``b`` is."""
+        return b // self.member_envs
+
+    def member_slice(self, k: int) -> slice:
+        """Member ``k``'s arenas, along the first axis of every state array."""
+        return slice(k * self.member_envs, (k + 1) * self.member_envs)
 
     def state_dict(self) -> dict:
         """A deep copy of the state (arrays, arenas, generators) for checkpoints."""
@@ -181,7 +208,7 @@ class VecEnv:
         s.width[b], s.height[b] = arena.width_cm, arena.height_cm
         pellets = sample_pellets(arena, rng)
         cap = len(pellets) + (arena.onepatch_cap if arena.layout == "onepatch" else 0)
-        s.grow_pellets(max(cap, 1))
+        s.grow_pellets(max(cap, 1), self.member_of(b))
         s.alive[b] = False
         s.pellet_xy[b, : len(pellets)] = pellets
         s.pellet_phi[b, : len(pellets)] = rng.uniform(0, 2 * np.pi, len(pellets))
@@ -202,9 +229,13 @@ class VecEnv:
         self._regrowing = [b for b, a in enumerate(self.state.arena) if a.layout == "onepatch"]
 
     def _food_dynamics(self) -> None:
-        """Orientation drift of every pellet (one draw for the batch), then one-patch regrowth."""
+        """Orientation drift of every pellet (one draw per member, over the pellet slots it has needed), then
+        one-patch regrowth."""
         s = self.state
-        drift_orientations(s.pellet_phi, self._drift_sd, s.noise_rng, out=s.pellet_phi)
+        for k in range(self.members):
+            rows, cap = self.member_slice(k), s.capacity[k]
+            s.pellet_phi[rows, :cap] = drift_orientations(s.pellet_phi[rows, :cap], self._drift_sd[rows],
+                                                          s.noise_rngs[k])
         n_alive = s.alive.sum(axis=1) if self._regrowing else None  # one count for the batch, not one per arena
         for b in self._regrowing:
             arena, rng = s.arena[b], s.rngs[b]
@@ -224,8 +255,9 @@ class VecEnv:
                                   e.bot_eod_rate, s.rngs[b])
             move[b, ids], turn[b, ids], eod[b, ids] = m, t, (f & ~self.muted[ids]) | forced
 
-    def _perceive(self, eod: np.ndarray, out: np.ndarray) -> None:
-        """Write the sensory part of the observation into ``out[..., :perception_width]``: receptors or rays."""
+    def _perceive(self, eod: np.ndarray, out: np.ndarray, members: Sequence[int] | None = None) -> None:
+        """Write the sensory part of the observation into ``out[..., :perception_width]``: receptors or rays; the
+        sensor noise is drawn for ``members`` (all by default), and the others' rows are not to be used."""
         s = self.state
         if self.cfg.sensors.perception == "raycast":
             shape = (self.num_envs, self.n, len(self.ray_angles))
@@ -237,16 +269,17 @@ class VecEnv:
             return
         raw = raw_readings(self.snapshot(eod), self.plan, reference=self.reference)
         if self.plan.noise:
-            self._noise_u = noise_uniforms(raw, s.noise_rng, out=self._noise_u)
+            rngs = [rng if members is None or k in members else None for k, rng in enumerate(s.noise_rngs)]
+            self._noise_u = noise_uniforms(raw, rngs, out=self._noise_u)
         encode_readings(raw, self._noise_u if self.plan.noise else None, eod & self.plan.on("eod_emission"),
                         s.size, self.plan, self.cfg.env.obs_agents - 1, out)
 
-    def _observe(self, eod: np.ndarray) -> np.ndarray:
+    def _observe(self, eod: np.ndarray, members: Sequence[int] | None = None) -> np.ndarray:
         """Observations float32[B, N, D] (docs/model/environment.md#observation): perception, then the tail, written
-        into one fresh array."""
+        into one fresh array; valid for the arenas of ``members`` (all by default)."""
         e, p, s = self.cfg.env, self.perception_width, self.state
         obs = np.empty((self.num_envs, self.n, p + sum(TAIL_SIZES)), np.float32)
-        self._perceive(eod, obs)
+        self._perceive(eod, obs, members)
         tail_kernel(s.last_action, s.was_bitten, s.size, s.bite_cd, s.eat_cd, s.displacement,
                     self._v_max, e.eat_cooldown, e.bite_cooldown, obs, p)
         return obs

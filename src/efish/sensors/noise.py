@@ -2,24 +2,48 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from ..physics.plan import EffectPlan
 from ..physics.readings import RawReadings
 
 
-def noise_uniforms(raw: RawReadings, rng: np.random.Generator, out: np.ndarray | None = None) -> np.ndarray:
+def noise_uniforms(raw: RawReadings, rng: np.random.Generator | Sequence[np.random.Generator | None],
+                   out: np.ndarray | None = None) -> np.ndarray:
     """U(0, 1) draws of one step of noise, float64, flat: Mormyromast | Ampullary | interference | Knollenorgan.
 
     One ``rng.random`` call for the whole batch (each block in C order). The
     noise factor is ``low + (high - low) * u``, which is what
     ``Generator.uniform(low, high)`` computes from the same draws, so this fixes
     the draw order for every consumer (``apply_noise`` and the fused encoder).
+
+    A sequence of K generators splits the batch's arenas into K equal members
+    (:class:`~efish.env.vec_env.VecEnv`): member k's arenas get the draws of
+    one call of the k-th generator, in the order that call would give a batch
+    of member k's arenas alone. A member whose generator is None draws nothing
+    (its share of ``out`` is left as it was).
     """
-    count = raw.mormyromast.size + 2 * raw.ampullary.size + raw.knollenorgan.size
+    blocks = (raw.mormyromast, raw.ampullary, raw.ampullary, raw.knollenorgan)
+    count = sum(block.size for block in blocks)
     if out is None or out.size != count:
         out = np.empty(count)
-    return rng.random(out=out)
+    rngs = [rng] if isinstance(rng, np.random.Generator) else list(rng)
+    if len(rngs) == 1 and rngs[0] is not None:
+        return rngs[0].random(out=out)
+    # each block of ``out`` as [K members, member's share]; a member's one draw fills its share of every block
+    views, start = [], 0
+    for block in blocks:
+        views.append(out[start: start + block.size].reshape(len(rngs), -1))
+        start += block.size
+    for k, member in enumerate(rngs):
+        if member is None:
+            continue
+        draws = member.random(sum(view.shape[1] for view in views))
+        for view, part in zip(views, np.split(draws, np.cumsum([v.shape[1] for v in views])[:-1]), strict=True):
+            view[k] = part
+    return out
 
 
 def apply_noise(raw: RawReadings, emitting: np.ndarray, plan: EffectPlan, rng: np.random.Generator) -> RawReadings:
