@@ -13,11 +13,13 @@ from efish.analysis._tables import DEFAULTS
 from efish.analysis.decoding import (
     DECODE_TARGETS,
     DECODED_COLUMNS,
+    LOG_DISTANCES,
     READOUT_TARGETS,
     SENSED_TARGETS,
     SKILL_COLUMNS,
     SUMMARY_COLUMNS,
     decode_episodes,
+    decoded_value,
     food_decode_episodes,
     heldout_skill,
     summarise,
@@ -73,7 +75,7 @@ def test_folds_hold_out_every_episode_whole_with_all_its_agents():
     """Each episode is scored once, on all its rows (two agents' steps pooled): it was in one test fold whole."""
     rng = np.random.default_rng(1)
     x, groups = planted(rng, n_episodes=7, per=60, d=5)
-    hidden, steps = frames(x, groups, agents=2, dist_agent_cm=x[:, 0] * 10 + 50)
+    hidden, steps = frames(x, groups, agents=2, dist_agent_cm=10 ** (1.5 + 0.2 * x[:, 0]))  # log10 linear in x
     table = decode_episodes(hidden, steps, {"dist_agent_cm": False}, folds=3)
     assert table["episode"].tolist() == list(range(7)) and (table["n"] == 60).all() and (table["folds"] == 3).all()
     assert table["skill"].min() > 0.99
@@ -101,11 +103,29 @@ def test_input_copies_are_readouts_and_every_target_is_a_steps_column():
     assert set(SENSED_TARGETS).isdisjoint(READOUT_TARGETS)
     assert DECODE_TARGETS == {**SENSED_TARGETS, **READOUT_TARGETS}
     assert set(READOUT_TARGETS) == {"turn_rad", "eod", "size", "knollen_spikes", "log_morm_sensed"}
-    assert {"dist_agent_cm", "n_agents_100cm", "dist_wall_cm", "bearing_agent_rad", "err_knollen_rad"} <= set(
-        SENSED_TARGETS)
+    assert {"dist_agent_cm", "n_agents_100cm", "dist_wall_cm", "bearing_agent_rad", "err_knollen_rad",
+            "log_morm_field"} <= set(SENSED_TARGETS)  # the Mormyromast field at the body centre: from the scene
     assert set(DECODE_TARGETS) <= {name for name, _, _ in COLUMNS["steps"]}
     # angles are circular; the realised turn is a small signed change, decoded as a number
     assert all(DECODE_TARGETS[c] == (c.endswith("_rad") and c != "turn_rad") for c in DECODE_TARGETS)
+
+
+def test_distances_are_decoded_as_their_log10_the_scale_of_the_fields():
+    """The third audit: the fields an agent senses a distance by fall as a power of it, and its inputs are
+    log-normalised, so a readout is linear in the log of a distance. A state that carries log10 of the
+    nearest-agent and wall distances (over two decades) decodes them perfectly; the Mormyromast field at the body
+    centre, already a log, is decoded as recorded; a distance of 0 has no log and is left out."""
+    rng = np.random.default_rng(4)
+    x, groups = planted(rng, n_episodes=8, per=60, d=4)
+    dist, wall = 10 ** (1 + 0.5 * x[:, 0]), 10 ** (0.5 + 0.4 * x[:, 1])
+    hidden, steps = frames(x, groups, dist_agent_cm=dist, dist_wall_cm=wall, log_morm_field=-6 + x[:, 2])
+    targets = {t: False for t in ("dist_agent_cm", "dist_wall_cm", "log_morm_field")}
+    skill = decode_episodes(hidden, steps, targets).groupby("target")["skill"].min()
+    assert (skill > 0.99).all(), skill
+    assert set(LOG_DISTANCES) == {c for c in DECODE_TARGETS if c.startswith("dist_")}
+    np.testing.assert_array_equal(decoded_value(pd.DataFrame({"dist_wall_cm": [100.0, 0.0, np.nan]}), "dist_wall_cm"),
+                                  [2.0, np.nan, np.nan])
+    assert decoded_value(steps, "log_morm_field").tolist() == steps["log_morm_field"].tolist()
 
 
 def test_the_per_episode_table_has_its_columns_and_marks_readouts_and_missing_columns():
@@ -128,7 +148,7 @@ def test_the_per_episode_table_has_its_columns_and_marks_readouts_and_missing_co
 def test_only_the_given_agents_states_are_decoded():
     rng = np.random.default_rng(2)
     x, groups = planted(rng, n_episodes=5, per=40, d=3)
-    hidden, steps = frames(x, groups, agents=2, dist_wall_cm=x[:, 0])
+    hidden, steps = frames(x, groups, agents=2, dist_wall_cm=10 ** x[:, 0])
     both = decode_episodes(hidden, steps, {"dist_wall_cm": False})
     homer = decode_episodes(hidden, steps, {"dist_wall_cm": False}, agent=1)
     assert (both["n"] == 40).all() and (homer["n"] == 20).all()
@@ -137,7 +157,7 @@ def test_only_the_given_agents_states_are_decoded():
 def test_the_summary_pools_the_episodes_errors_so_that_a_constant_episode_does_not_swamp_it():
     rng = np.random.default_rng(3)
     x, groups = planted(rng, n_episodes=8, per=30, d=4)
-    dist = x[:, 0] + 0.5 * rng.normal(size=len(x))
+    dist = 10 ** (x[:, 0] + 0.5 * rng.normal(size=len(x)))
     eod = np.where(groups == 0, 0.0, (x[:, 1] > 1.5).astype(float))  # rare, and never in episode 0
     hidden, steps = frames(x, groups, dist_agent_cm=dist, eod=eod)
     episodes = decode_episodes(hidden, steps)
@@ -164,7 +184,8 @@ def test_food_decoding_splits_at_the_near_distance_and_scores_only_where_the_sta
     near = dist <= 10
     # the hidden state carries the food distance (and bearing) only when food is near
     bearing = rng.uniform(-np.pi, np.pi, len(x))
-    x = np.c_[x, np.where(near, dist, 0.0), np.where(near, np.cos(bearing), 0), np.where(near, np.sin(bearing), 0)]
+    code = np.log10(dist)  # a distance is decoded as its log10
+    x = np.c_[x, np.where(near, code, 0.0), np.where(near, np.cos(bearing), 0), np.where(near, np.sin(bearing), 0)]
     hidden, steps = frames(x, groups, dist_food_cm=dist, bearing_food_rad=bearing)
     episodes = food_decode_episodes(hidden, steps, near_cm=10.0)
     assert list(episodes.columns) == ["food", *DECODED_COLUMNS]
@@ -182,7 +203,7 @@ def test_food_is_near_within_the_configured_5_cm_by_default():
     assert DEFAULTS.claims_food_near_cm == 5.0  # the authors' Mormyromast food range
     rng = np.random.default_rng(0)
     x, groups = planted(rng, n_episodes=6, per=40, d=3)
-    dist = np.tile(np.linspace(0.0, 12.0, 40), 6)
+    dist = np.tile(np.linspace(0.25, 12.0, 40), 6)
     hidden, steps = frames(x, groups, dist_food_cm=dist, bearing_food_rad=x[:, 0])
     table = summarise(food_decode_episodes(hidden, steps), by=("food",)).set_index(["food", "target"])
     assert table.loc[("near", "dist_food_cm"), "n"] == np.sum(dist <= 5.0)

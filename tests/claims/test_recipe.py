@@ -7,7 +7,15 @@ import pandas as pd
 import pytest
 from scipy import stats
 
-from efish.claims.recipe import RECIPE_COLUMNS, RECIPE_PART_COLUMNS, pooled, recipe_parts, with_recipe_verdicts
+from efish.claims.fig3 import excess_w
+from efish.claims.recipe import (
+    RECIPE_COLUMNS,
+    RECIPE_PART_COLUMNS,
+    decide,
+    pooled,
+    recipe_parts,
+    with_recipe_verdicts,
+)
 from efish.claims.verdicts import PART_COLUMNS, ROW_COLUMNS
 
 ALPHA = 0.05
@@ -89,6 +97,17 @@ def test_a_no_difference_part_holds_when_the_seeds_are_equivalent_and_fails_beyo
     assert far["verdict"] == "fails"
 
 
+def test_a_no_difference_part_whose_margin_the_seeds_cannot_reach_is_not_decidable():
+    """Seeds' effects of SD 0.9 about 0 over 4 seeds (SE 0.45) against a margin of 0.5: margin / SE 1.1 is below the
+    one-sided critical t (2.35 at 3 df), so even a zero mean could not be shown equivalent: not decidable, with the
+    reason, where it read "weaker"; a margin of 2 can be shown."""
+    spread = [1.0, -1.0, 0.8, -0.9]
+    narrow = verdict_of(spread, sign=0.0, margin=0.5)
+    assert narrow["verdict"] == "not decidable" and "cannot be shown over 4 seeds" in narrow["reason"]
+    assert verdict_of(spread, sign=0.0, margin=2.0)["verdict"] == "holds"
+    assert verdict_of([3.0, 3.2, 2.9, 3.1], sign=0.0, margin=0.5)["verdict"] == "fails"  # beyond it still fails
+
+
 def test_seeds_that_cannot_carry_the_part_are_left_out_and_named():
     seeds = seeds_of([0.5, 0.55, 0.45, np.nan])
     seeds[3] = part_table({"a": np.nan}, verdict="not decidable", p_floor=0.0)  # a ceiling: no effect
@@ -137,3 +156,43 @@ def test_a_claim_no_other_seed_runs_is_one_draw_not_a_missing_recipe():
     row = recipe_parts(seeds, 1, ALPHA).iloc[0]
     assert row["verdict"] == "holds" and row["n"] == 1 and row["effect"] == 0.5 and "one draw" in row["reason"]
 
+
+
+def test_an_any_difference_part_counts_only_an_excess_above_its_null():
+    """An "any difference" part's effect is an excess over its null expectation (C5's Kendall's W - 1/n), which
+    every departure from the null raises: seeds whose mean excess lies below 0 show no difference (weaker, p 1),
+    where the two-sided t-test over seeds held them; above 0 the p is the two-sided t-test's."""
+    below = verdict_of([-0.10, -0.12, -0.09, -0.11], sign=np.nan)
+    assert below["verdict"] == "weaker" and below["p"] == 1.0 and "upper side" in below["ci_method"]
+    above = verdict_of([0.10, 0.12, 0.09, 0.11], sign=np.nan)
+    assert above["verdict"] == "holds" and above["ci_low"] > 0
+    assert above["p"] == pytest.approx(stats.ttest_1samp([0.10, 0.12, 0.09, 0.11], 0.0).pvalue)
+
+
+def _c5_recipe_verdicts(rates: np.ndarray) -> np.ndarray:
+    """The recipe verdicts of C5's part in simulated runs: ``rates`` [run, seed, episode, bin], each seed's effect
+    W - 1/n of its episodes' rates (efish.claims.fig3.excess_w, as C5 computes it), decided over the seeds as
+    recipe_parts decides an "any difference" part (:func:`efish.claims.recipe.decide`)."""
+    effects, _ = excess_w(rates)
+    return np.array([decide(seeds, None, ALPHA).verdict for seeds in effects])
+
+
+def test_c5s_recipe_holds_at_most_alpha_without_a_distance_effect_and_mostly_with_one():
+    """The third audit: testing the seeds' Kendall's W against 0 held C5 in 67-100% of runs with no distance
+    effect, W being never negative. With the seeds' W - 1/n and the upper side of their mean, 1,000 simulated runs
+    of 4 seeds (the laptop scale's top seeds) at 6 episodes and 8 distance bins, the rates noise, hold at most
+    alpha plus three Monte-Carlo standard errors (about 1% in fact: the seeds' effects are skewed to the right,
+    which makes the upper side conservative) and never fail; with a planted distance effect, most hold."""
+    rng = np.random.default_rng(5)
+    runs, seeds, episodes, bins = 1000, 4, 6, 8
+    null = _c5_recipe_verdicts(rng.normal(size=(runs, seeds, episodes, bins)))
+    assert set(null) <= {"holds", "weaker"}  # an "any difference" part cannot fail
+    assert (null == "holds").mean() <= ALPHA + 3 * np.sqrt(ALPHA * (1 - ALPHA) / runs), (null == "holds").mean()
+    planted = _c5_recipe_verdicts(rng.normal(size=(runs, seeds, episodes, bins)) + 0.4 * np.arange(bins))
+    assert (planted == "holds").mean() > 0.8, (planted == "holds").mean()
+    # the same seeds' effects decide so in recipe_parts, from their claim_parts rows
+    effects = excess_w(rng.normal(size=(seeds, episodes, bins)) + 0.4 * np.arange(bins))[0]
+    row = recipe_parts({s + 1: part_table({"a": e}, sign=np.nan, claim="C5") for s, e in enumerate(effects)}, 1,
+                       ALPHA).iloc[0]
+    assert row["verdict"] == decide(effects, None, ALPHA).verdict == "holds"
+    assert row["p"] == decide(effects, None, ALPHA).p

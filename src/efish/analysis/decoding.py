@@ -20,13 +20,21 @@ from ._tables import DEFAULTS, nan_frame
 from .dynamics import _with_steps, units
 
 #: Steps columns of the world the agent senses (docs/methods/analyses.md#decoding-variables) -> circular (radians)
-#: or not: the variables ranked against each other (Fig 6D,E) and the only competitors of claim C19. Each describes
-#: the world after step t, which the hidden row t has taken in (efish.rollout.run.hidden_table); none is computed
-#: from the observation itself. The homing error angles are NaN outside homing.
+#: or not: the variables ranked against each other (Fig 6D,E), among which claim C19 takes its competitors. Each
+#: describes the world after step t, which the hidden row t has taken in (efish.rollout.run.hidden_table); none is
+#: computed from the observation itself (``log_morm_field``, the field the own EOD induces on the other bodies at
+#: the body centre, is computed from the scene). The homing error angles are NaN outside homing.
 SENSED_TARGETS = {"dist_agent_cm": False, "bearing_agent_rad": True, "dist_agent2_cm": False, "size_agent1": False,
                   "size_agent2": False, "n_agents_100cm": False, "dist_food_cm": False, "bearing_food_rad": True,
                   "food_count_5cm": False, "dist_wall_cm": False, "bearing_wall_rad": True, "log_amp_field": False,
-                  "err_knollen_rad": True, "err_morm_rad": True, "err_amp_rad": True}
+                  "log_morm_field": False, "err_knollen_rad": True, "err_morm_rad": True, "err_amp_rad": True}
+#: Distances decoded as log10 of the distance, the scale of the fields the agent senses them by: a dipole's field
+#: falls as a power of the distance, so the recorded fields (``log_amp_field``, ``log_morm_field``) and the
+#: network's log-normalised sensor inputs are linear in the log of a distance, not in the distance, and a linear
+#: readout of centimetres would score the shape of that curve rather than what the state carries (the third
+#: audit). Every distance the rollout records is positive (bodies keep their radius from walls and from each
+#: other); a distance <= 0 has no log and is left out, as a NaN is.
+LOG_DISTANCES = ("dist_agent_cm", "dist_agent2_cm", "dist_food_cm", "dist_wall_cm")
 #: Steps columns that are copies of the decoded network's own input (docs/claims/index.md#rule-7): the turn and EOD
 #: of step t (its last action, fed back in the observation row t's state takes in), the agent's own size (in every
 #: observation), and two summaries computed from the observation of step t alone (the Knollenorgan inputs that
@@ -124,6 +132,16 @@ def heldout_skill(x: np.ndarray, y: np.ndarray, groups: np.ndarray, circular: bo
     return pd.DataFrame(rows, columns=SKILL_COLUMNS).sort_values("episode", kind="stable", ignore_index=True)
 
 
+def decoded_value(steps: pd.DataFrame, target: str) -> np.ndarray:
+    """The values of ``target`` a readout decodes: the steps column, as log10 for the :data:`LOG_DISTANCES` (NaN
+    where the distance is not positive)."""
+    y = steps[target].to_numpy(np.float64)
+    if target not in LOG_DISTANCES:
+        return y
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(y > 0, np.log10(np.where(y > 0, y, 1.0)), np.nan)
+
+
 def decode_episodes(hidden: pd.DataFrame, steps: pd.DataFrame, targets: dict[str, bool] | None = None,
                     folds: int = DEFAULTS.decode_folds, agent: int | None = None) -> pd.DataFrame:
     """:func:`heldout_skill` of every target column of ``steps`` from the hidden state, per condition and episode
@@ -132,10 +150,12 @@ def decode_episodes(hidden: pd.DataFrame, steps: pd.DataFrame, targets: dict[str
     All agents of a condition are pooled (only ``agent``'s rows when given:
     the homer of the homing assay) and an episode's rows, of every agent, are
     held out together. ``targets`` maps a steps column to whether it is
-    circular (default :data:`DECODE_TARGETS`). One row per condition, target
-    and episode (columns :data:`DECODED_COLUMNS`; ``readout`` True for the
-    targets of :data:`READOUT_TARGETS`); a target the steps table lacks, or one
-    that cannot be decoded, is one row per condition with episode NaN and the reason.
+    circular (default :data:`DECODE_TARGETS`); a distance of
+    :data:`LOG_DISTANCES` is decoded as its log10 (:func:`decoded_value`),
+    under its column's name. One row per condition, target and episode
+    (columns :data:`DECODED_COLUMNS`; ``readout`` True for the targets of
+    :data:`READOUT_TARGETS`); a target the steps table lacks, or one that
+    cannot be decoded, is one row per condition with episode NaN and the reason.
     """
     targets = DECODE_TARGETS if targets is None else targets
     hidden = hidden if agent is None else hidden[hidden["agent"] == agent]
@@ -145,7 +165,7 @@ def decode_episodes(hidden: pd.DataFrame, steps: pd.DataFrame, targets: dict[str
     for cond, sub in joined.groupby("condition", sort=True):
         x, episodes = sub[h].to_numpy(np.float64), sub["episode"].to_numpy()
         for target, circular in targets.items():
-            skills = (heldout_skill(x, sub[target].to_numpy(np.float64), episodes, circular, folds)
+            skills = (heldout_skill(x, decoded_value(sub, target), episodes, circular, folds)
                       if target in present else nan_frame(f"steps table lacks column {target!r}", episode=np.nan))
             parts.append(skills.assign(condition=cond, target=target, circular=circular,
                                        readout=target in READOUT_TARGETS))

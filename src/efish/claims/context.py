@@ -24,7 +24,7 @@ from ..config.recorded import recorded_conditions
 from ..config.schema import EfishConfig
 from ..layout import assay_table, parse_table
 from .statistics import bootstrap_ci
-from .verdicts import MIN_UNITS, Outcome, Part, combine, judge
+from .verdicts import MIN_UNITS, Outcome, Part, combine, judge, unreachable
 
 #: ``ci_method`` of an interval no test inverts: every such interval resamples episodes (:meth:`Context.ci`).
 BOOTSTRAP = "bootstrap percentile over episodes"
@@ -48,8 +48,9 @@ def evaluate(label: str, statistic: str, compute: Callable[[], Outcome], alpha: 
     The part's ``p`` is the one its verdict rests on: the TOST p for a "no
     difference" part (sign 0), else the difference test's. Fewer than
     :data:`~efish.claims.verdicts.MIN_UNITS` units is ``not run``; a test that
-    cannot reach p < alpha at its n (``Outcome.p_floor``) is ``not decidable``
-    and says so, rather than weaker.
+    cannot reach p < alpha at its n (``Outcome.p_floor``; for a "no difference"
+    part, its equivalence test within the margin) is ``not decidable`` and says
+    so, rather than weaker (:func:`~efish.claims.verdicts.unreachable`).
     """
     try:
         out = compute()
@@ -71,10 +72,10 @@ def evaluate(label: str, statistic: str, compute: Callable[[], Outcome], alpha: 
         return judged("not run", f"n = {out.n}: a test needs at least {MIN_UNITS} units", out.reason)
     if not (np.isfinite(out.effect) and np.isfinite(p)):
         return judged("not run", out.reason or "no test result")
-    if out.p_floor >= alpha:
+    verdict, why = judge(out.effect, out.p, out.sign, alpha, out.p_equiv, out.margin)
+    if unreachable(verdict, out.p_floor, alpha, out.sign):
         return judged("not decidable", f"cannot reach significance at n = {out.n} (the smallest p its test can give "
                                        f"is {out.p_floor:.3g})", out.reason)
-    verdict, why = judge(out.effect, out.p, out.sign, alpha, out.p_equiv, out.margin)
     return judged(verdict, why, out.reason)
 
 

@@ -57,12 +57,37 @@ def _aligned(ctx: Context) -> pd.DataFrame:
     return rows
 
 
+#: The straight homer's aligned fraction at which its reference is at a ceiling (rule 5): aligned on 90% of its
+#: steps or more, it leaves at most a tenth of the steps to align beyond it, so an excess the part tests cannot
+#: appear (the third audit: a median room of 0.049). The counterpart of a control eating every pellet, counted
+#: over episodes by the same ``analysis.claims_ceiling_share``.
+REFERENCE_CEILING = 0.9
+
+
+def reference_ceiling(ctx: Context, per: pd.DataFrame) -> Outcome | None:
+    """A "not decidable" outcome when the straight homer's aligned fraction (``straight_aligned_fraction`` of the
+    episodes ``per``) is at least :data:`REFERENCE_CEILING` in at least ``analysis.claims_ceiling_share`` of the
+    episodes (rule 5: a reference at its ceiling leaves no room for a positive excess), else None."""
+    reference = per["straight_aligned_fraction"].to_numpy(np.float64)
+    reference = reference[np.isfinite(reference)]
+    full = float(np.mean(reference >= REFERENCE_CEILING)) if reference.size else 0.0
+    if full < ctx.cfg.analysis.claims_ceiling_share:
+        return None
+    return Outcome(np.nan, np.nan, len(per), +1, verdict="not decidable",
+                   reason=f"at a ceiling: a homer heading straight at the target is aligned on at least "
+                          f"{REFERENCE_CEILING:.0%} of the steps in {full:.0%} of the {reference.size} successful "
+                          f"episodes (median room above it {np.median(1 - reference):.3g}), so no excess alignment "
+                          "can appear")
+
+
 @claim("C2", "2C", "the error angle is bimodal near parallel and anti-parallel to the target's field", [ALIGNMENT])
 def c2(ctx: Context) -> list[Part]:
     a = ctx.cfg.analysis.claims_aligned_rad
 
     def compute() -> Outcome:
         per = _aligned(ctx)
+        if (full := reference_ceiling(ctx, per)) is not None:
+            return full
         out = one_sample_part(ctx, per, "aligned_excess", 0.0, +1)
         note = (f"median aligned fraction {per['aligned_fraction'].median():.3f} vs "
                 f"{per['straight_aligned_fraction'].median():.3f} for a straight homer on the same positions, over "

@@ -19,7 +19,7 @@ import pandas as pd
 
 from ..layout import analysis_table
 from .context import Context, claim
-from .parts import ceiling, mann_whitney_part, margin_for, paired_part, present, spearman_part
+from .parts import ceiling, mann_whitney_part, margin_for, paired_part, present, spearman_part, with_margin
 from .statistics import excess_theil_per_episode, pooled_sd, welch_tost
 from .verdicts import Outcome, Part
 
@@ -136,11 +136,12 @@ def c13(ctx: Context) -> list[Part]:
     def theil() -> Outcome:
         d = layouts().dropna(subset=["excess_theil"])
         x, c = (d.loc[d["condition"] == g, "excess_theil"].to_numpy() for g in ("patchy4", "uniform4"))
-        margin = margin_for(ctx, c, pooled_sd(x, c))
-        diff, p, p_equiv, ci = welch_tost(x, c, margin[0], ctx.cfg.analysis.claims_alpha)
-        m, ratio, how = margin
-        return Outcome(diff, p, len(d), 0, ci, f"margin +-{m:.3g} = {how} ({ratio:.0%} of the control's typical "
-                       "value)", p_equiv=p_equiv, margin=m, margin_ratio=ratio, ci_method="inverts Welch's t-test")
+        margin, alpha = margin_for(ctx, c, pooled_sd(x, c)), ctx.cfg.analysis.claims_alpha
+        diff, p, p_equiv, ci = welch_tost(x, c, margin[0], alpha)
+        # the Welch TOST of the same samples shifted to a zero difference: t.sf(margin / SE) at Welch's df
+        p_zero = welch_tost(x - diff, c, margin[0], alpha)[2]
+        return with_margin(ctx, Outcome(diff, p, len(d), 0, ci, ci_method="inverts Welch's t-test"), margin,
+                           p_equiv, p_zero)
 
     def sweep(series: str, value: str) -> Outcome:
         return spearman_part(ctx, _npatch(ctx).query("series == @series"), "n", value, -1)

@@ -75,12 +75,22 @@ def c18(ctx: Context) -> list[Part]:
                      "the target; Wilcoxon", compute)]
 
 
-#: Among the sensed variables (efish.analysis.decoding.SENSED_TARGETS, the ones Fig 6E ranks), the nearest-agent
-#: distance and the Knollenorgan feature (agents in Knollenorgan range) the paper finds best.
+#: The world variables of Fig 6E that claim C19 ranks (docs/claims/index.md#c19), all sensed
+#: (efish.analysis.decoding.SENSED_TARGETS): the nearest-agent distance and the Knollenorgan feature (agents in
+#: Knollenorgan range; with wide2's two agents, also whether one is) the paper finds best ...
 AGENT_FEATURES = ("dist_agent_cm", "n_agents_100cm")
+#: ... and the others it ranks them against: the Mormyromast field at the body centre (log10, computed from the
+#: scene) and the wall distance, the competitors the claim's statement of Fig 6E names. Bearings, sizes, food and
+#: the Ampullary field are decoded for Fig 6E and listed in the reason, not ranked here.
+OTHER_FEATURES = ("log_morm_field", "dist_wall_cm")
 WIDE2_DECODING = analysis_table("dynamics", "wide2", "decoding")
 WIDE2_DECODED = analysis_table("dynamics", "wide2", "decoding_episodes")
 WIDE2_FOOD_DECODED = analysis_table("dynamics", "wide2", "food_decoding_episodes")
+
+
+def _listed(skills: pd.Series) -> str:
+    """Decoding skills, best first, as the reason lists them ("dist_agent_cm 0.85, ...")."""
+    return ", ".join(f"{k} {v:.2f}" for k, v in skills.sort_values(ascending=False).items())
 
 
 @claim("C19", "6E,F", "nearest-agent distance and Knollenorgan features decode best; food variables decode better "
@@ -89,17 +99,21 @@ def c19(ctx: Context) -> list[Part]:
     near_cm = ctx.cfg.analysis.claims_food_near_cm
 
     def ranking() -> Outcome:
-        """The best agent feature against the best other sensed variable, ranked by Fig 6E's pooled skill (dynamics
-        decoding), paired over the episodes of decoding_episodes."""
+        """The best agent feature against the best other ranked variable (:data:`OTHER_FEATURES`), by Fig 6E's
+        pooled skill (dynamics decoding; distances decoded as log10), paired over the episodes of
+        decoding_episodes."""
         summary = ctx.table(WIDE2_DECODING)
-        skill = summary[summary["target"].isin(list(SENSED_TARGETS))].groupby("target")["skill"].mean().dropna()
-        ours, rest = skill.reindex(AGENT_FEATURES).dropna(), skill.drop(list(AGENT_FEATURES), errors="ignore")
+        sensed = summary[summary["target"].isin(list(SENSED_TARGETS))].groupby("target")["skill"].mean().dropna()
+        skill = sensed.reindex([*AGENT_FEATURES, *OTHER_FEATURES]).dropna()
+        ours, rest = skill.reindex(AGENT_FEATURES).dropna(), skill.reindex(OTHER_FEATURES).dropna()
         if ours.empty or rest.empty:
-            raise ValueError("no agent or no other sensed variable with a finite decoding skill")
+            raise ValueError(f"no agent feature {list(AGENT_FEATURES)} or no other ranked variable "
+                             f"{list(OTHER_FEATURES)} with a finite decoding skill")
         best, other = ours.idxmax(), rest.idxmax()
         out = paired_difference(ctx, decoded(ctx, WIDE2_DECODED, [best, other]), best, other)
-        ranked = ", ".join(f"{k} {v:.2f}" for k, v in skill.sort_values(ascending=False).items())
-        return dataclasses.replace(out, reason="; ".join(r for r in (out.reason, f"skill (Fig 6E): {ranked}") if r))
+        notes = (out.reason, f"skill (Fig 6E): {_listed(skill)}",
+                 f"not ranked: {_listed(sensed.drop(skill.index))}" if len(sensed) > len(skill) else "")
+        return dataclasses.replace(out, reason="; ".join(r for r in notes if r))
 
     def food() -> Outcome:
         """Per episode, the mean skill of the food variables near minus far (dynamics food_decoding_episodes)."""
@@ -107,8 +121,9 @@ def c19(ctx: Context) -> list[Part]:
         per = skills.groupby(["condition", "episode", "food"], as_index=False)["skill"].mean()
         return paired_difference(ctx, per, "near", "far", key="food")
     return [ctx.part("agent features best", "Hodges-Lehmann estimate over episodes of held-out skill of the best agent or "
-                     "Knollenorgan feature minus the best other sensed variable (wide2, dynamics decoding_episodes; "
-                     "readouts of the network's own input excluded); Wilcoxon", ranking),
+                     "Knollenorgan feature minus the best of the Mormyromast field and the wall distance (wide2, "
+                     "dynamics decoding_episodes; distances as log10; readouts of the network's own input "
+                     "excluded); Wilcoxon", ranking),
             ctx.part("food near > far", f"Hodges-Lehmann estimate over episodes of held-out skill of food distance and bearing, "
                      f"nearest pellet within {near_cm:g} cm minus beyond (dynamics food_decoding_episodes); Wilcoxon",
                      food)]

@@ -183,12 +183,23 @@ def margin_for(ctx: Context, control: np.ndarray, spread: float) -> tuple[float,
     return equivalence_margin(np.asarray(control, np.float64), spread, a.claims_margin_fraction, a.claims_margin_sd)
 
 
-def _with_margin(out: Outcome, margin: tuple[float, float, str], p_equiv: float, p_floor: float) -> Outcome:
-    """``out`` with its equivalence test: the TOST p within the margin, the margin and its ratio in the row."""
+def with_margin(ctx: Context, out: Outcome, margin: tuple[float, float, str], p_equiv: float,
+                p_zero: float) -> Outcome:
+    """``out`` with its equivalence test: the TOST p within the margin, the margin and its ratio in the row.
+
+    ``p_zero`` is the TOST p the part's own test gives to its data shifted to a zero difference (the same spread
+    and n): the smallest TOST p the part can reach, its ``p_floor``. Where it is >= alpha the margin is narrower
+    than the test can resolve at this n (for a t-test, margin / SE is below the one-sided critical t), so the part
+    could not be shown equivalent even at no difference at all: not decidable, as a test that cannot reach
+    significance at its n (:func:`~efish.claims.verdicts.unreachable`; the third audit found 11 of 12 seed-level
+    equivalence parts so)."""
     m, ratio, how = margin
-    note = f"margin +-{m:.3g} = {how} ({ratio:.0%} of the control's typical value)"
-    return dataclasses.replace(out, p_equiv=p_equiv, margin=m, margin_ratio=ratio, p_floor=p_floor,
-                               reason="; ".join(r for r in (out.reason, note) if r))
+    notes = [out.reason, f"margin +-{m:.3g} = {how} ({ratio:.0%} of the control's typical value)"]
+    if p_zero >= ctx.cfg.analysis.claims_alpha:
+        notes.append(f"the margin cannot be shown at this n: a zero difference with this spread gives a TOST p of "
+                     f"{p_zero:.3g}")
+    return dataclasses.replace(out, p_equiv=p_equiv, margin=m, margin_ratio=ratio, p_floor=p_zero,
+                               reason="; ".join(r for r in notes if r))
 
 
 def paired_part(ctx: Context, summary: pd.DataFrame, measure: str, condition: str, control: str,
@@ -215,7 +226,7 @@ def paired_part(ctx: Context, summary: pd.DataFrame, measure: str, condition: st
     if sign != 0:
         return out
     margin = margin_for(ctx, both[control].to_numpy(), float(np.std(d, ddof=1)) if d.size > 1 else 0.0)
-    return _with_margin(out, margin, tost_paired(d, margin[0]), smallest_p_signed_rank(d.size, sides=1))
+    return with_margin(ctx, out, margin, tost_paired(d, margin[0]), tost_paired(d - out.effect, margin[0]))
 
 
 def unpaired_equivalence(ctx: Context, frame: pd.DataFrame, value: str, group: str, a, b) -> Outcome:
@@ -225,7 +236,7 @@ def unpaired_equivalence(ctx: Context, frame: pd.DataFrame, value: str, group: s
     x, c = (frame.loc[frame[group] == g, value].to_numpy(np.float64) for g in (a, b))
     x, c = x[np.isfinite(x)], c[np.isfinite(c)]
     margin = margin_for(ctx, c, pooled_sd(c, x))
-    return _with_margin(out, margin, tost_unpaired(x, c, margin[0]), smallest_p_rank_sum(x.size, c.size, sides=1))
+    return with_margin(ctx, out, margin, tost_unpaired(x, c, margin[0]), tost_unpaired(x - out.effect, c, margin[0]))
 
 
 def ceiling(ctx: Context, summary: pd.DataFrame, conditions: Iterable[str]) -> Outcome | None:

@@ -62,7 +62,8 @@ class Outcome:
     ``margin_ratio`` is the margin over the control's typical value.
     ``ci_method`` says how ``ci`` was made (it inverts the test, or resamples).
     ``p_floor`` is the smallest p the part's test can give at its n, after its
-    multiplicity correction: at or above alpha the part cannot be significant.
+    multiplicity correction: at or above alpha the part cannot be significant
+    (for sign 0, the TOST p of its data shifted to a zero difference).
     ``family``: the number of comparisons ``p`` is Holm-adjusted over (1: none).
     """
 
@@ -130,6 +131,19 @@ def judge(effect: float, p: float, sign: int | None, alpha: float, p_equiv: floa
         return (("fails", f"opposite sign, significant (p = {p:.3g})") if significant
                 else ("weaker", f"opposite sign, not significant (p = {p:.3g})"))
     return "weaker", "zero effect"
+
+
+def unreachable(verdict: str, p_floor: float, alpha: float, sign: int | None) -> bool:
+    """Whether a part that its rule judged ``verdict`` is *not decidable* instead, because its test cannot give
+    p < ``alpha`` at its n (``p_floor``, the smallest p it can reach, is >= alpha): the data could not have shown
+    what the part tests, so "weaker" would blame the effect for the size of the run. For a "no difference" part
+    (``sign`` 0) the floor is its equivalence test's (a margin too narrow for its standard error cannot be shown
+    even at a zero difference); such a part may still fail, by its difference test, which has a floor of its own.
+
+    >>> unreachable("weaker", 0.0625, 0.05, +1), unreachable("fails", 0.2, 0.05, 0), unreachable("weaker", 0.01, 0.05, 0)
+    (True, False, False)
+    """
+    return bool(p_floor >= alpha) and not (sign == 0 and verdict == "fails")
 
 
 def combined_verdict(verdicts: Iterable[str]) -> str:
