@@ -212,10 +212,14 @@ def _assay_commands(sub: argparse._SubParsersAction) -> None:
                       "records hidden states). Writes <table>.parquet, config.yaml and provenance.json to --out.",
                       "docs/methods/assays.md", "docs/reference/tables.md")
     add_overrides(asy, example="assay=patchy4 scale=smoke")
-    asy.add_argument("--policy", nargs="+", required=True, metavar="[NAME=]PATH",
+    asy.add_argument("--policy", nargs="+", default=[], metavar="[NAME=]PATH",
                      help="training folder, final.pt or checkpoint.pt of each policy the conditions act with "
                           "(NAME: selected, homing, homing_raycast, ...; a bare PATH is the assay's own policy)")
-    _add_out(asy, "output folder (default results/{run}/assays/{assay})")
+    asy.add_argument("--group", nargs="+", metavar="MEMBER=PATH",
+                     help="several policies that each act as the assay's own policy (e.g. the top seeds, MEMBER their "
+                          "seed numbers), all in one env on the same episodes: each member's tables equal its run "
+                          "alone, and go to --out with {member} replaced by its name")
+    _add_out(asy, "output folder (default results/{run}/assays/{assay}); with --group a template holding {member}")
     asy.set_defaults(handler=_assay)
     an = add_command(sub, "analyze", "run one analysis of an assay's rollout tables",
                      "Run one analysis (efish.analysis.registry) of an assay's rollout tables under the config's "
@@ -541,28 +545,44 @@ def _watch(args, cfg, started) -> None:
 
 def _assay(args, cfg, started) -> None:
     from .rl.policy import load_policy
-    from .rollout.assay import run_assay
+    from .rollout.assay import run_assay_group
     from .rollout.tables import write_tables
 
+    if not args.policy and not args.group:
+        raise ValueError("efish assay needs --policy (or --group): the trained policies the conditions act with")
     paths = policy_paths(args.policy, cfg.assay.policy)
+    group = policy_paths(args.group, None, "--group") if args.group else {}
+    if group and "{member}" not in str(args.out or ""):
+        raise ValueError("--group needs an --out template holding {member}, e.g. "
+                         "results/laptop/seeds/seed_{member}/assays/patchy4")
+    if not group and "{member}" in str(args.out or ""):
+        raise ValueError("--out holds {member}, which only --group fills")
     policies = {name: load_policy(path) for name, path in paths.items()}
-    out = args.out or run_of(cfg, args.overrides).path(assay_folder(cfg.assay.name))
-    tables, stats = run_assay(args.overrides, policies, progress=lambda c: print(f"condition {c} done",
-                                                                                  file=sys.stderr, flush=True))
-    write_tables(tables, out)
-    write_metadata(out, cfg, started, args, policies={k: str(v) for k, v in paths.items()}, **stats)
-    print(f"wrote {', '.join(f'{k}.parquet ({len(v)} rows)' for k, v in tables.items())} to {out} "
-          f"({stats['env_steps_per_s']:,.0f} env-steps/s)")
+    members = [{cfg.assay.policy: load_policy(path)} for path in group.values()] or [{}]
+    outs = ([Path(str(args.out).replace("{member}", name)) for name in group] if group
+            else [args.out or run_of(cfg, args.overrides).path(assay_folder(cfg.assay.name))])
+    shared = {k: v for k, v in policies.items() if not (group and k == cfg.assay.policy)}
+    all_tables, stats = run_assay_group(args.overrides, shared, members,
+                                        progress=lambda c: print(f"condition {c} done", file=sys.stderr, flush=True))
+    for out, tables, member_path in zip(outs, all_tables, [*group.values()] or [None], strict=True):
+        write_tables(tables, out)
+        used = {**paths, **({cfg.assay.policy: member_path} if member_path else {})}
+        write_metadata(out, cfg, started, args, policies={k: str(v) for k, v in used.items()}, **stats)
+        print(f"wrote {', '.join(f'{k}.parquet ({len(v)} rows)' for k, v in tables.items())} to {out} "
+              f"({stats['env_steps_per_s']:,.0f} env-steps/s)")
 
 
-def policy_paths(entries: list[str], default: str) -> dict[str, Path]:
-    """``--policy`` entries ``NAME=PATH`` (or a bare ``PATH`` for the assay's own policy, ``default``)."""
+def policy_paths(entries: list[str], default: str | None, flag: str = "--policy") -> dict[str, Path]:
+    """``--policy`` entries ``NAME=PATH`` (or a bare ``PATH`` for the assay's own policy, ``default``; with
+    ``default`` None every entry must name itself, as ``--group``'s do)."""
     paths = {}
     for entry in entries:
         name, sep, path = entry.partition("=")
+        if not sep and default is None:
+            raise ValueError(f"{flag} entry {entry!r} must be MEMBER=PATH")
         name, path = (name, path) if sep else (default, entry)
         if name in paths:
-            raise ValueError(f"--policy names {name!r} twice")
+            raise ValueError(f"{flag} names {name!r} twice")
         paths[name] = Path(path)
     return paths
 

@@ -170,3 +170,21 @@ def test_assay_with_a_policy_of_another_shape_fails_clearly(policy_dir, tmp_path
     assert code == 2 and "observation has 83 values but policy 'selected' takes 110" in err
     assert len(err.strip().splitlines()) == 1 and not (tmp_path / "x").exists()
     load_policy(policy_dir)
+
+
+def test_a_group_of_policies_writes_each_members_tables_as_alone(policy_dir, tmp_path, capsys):
+    """``efish assay --group``: the same checkpoint as two members, and a second checkpoint of another seed; each
+    member's folder holds the tables its run alone writes."""
+    other = tmp_path / "train2"
+    train(compose([*TINY_TRAIN, "train.seed=2"]), other)
+    args = ["assay", "assay=patchy4", "env.n_agents=2", *SHORT]
+    assert main([*args, "--group", f"1={policy_dir}", f"2={other}", "--out", str(tmp_path / "seed_{member}")]) == 0
+    for seed, path in ((1, policy_dir), (2, other)):
+        assert main([*args, "--policy", str(path), "--out", str(tmp_path / f"alone_{seed}")]) == 0
+        for table in ("steps", "episodes", "food", "hidden", "conditions"):
+            pd.testing.assert_frame_equal(pd.read_parquet(tmp_path / f"seed_{seed}" / f"{table}.parquet"),
+                                          pd.read_parquet(tmp_path / f"alone_{seed}" / f"{table}.parquet"))
+        assert (tmp_path / f"seed_{seed}" / "provenance.json").exists()
+    capsys.readouterr()
+    assert main([*args, "--group", f"1={policy_dir}", "--out", str(tmp_path / "no_template")]) == 2
+    assert "{member}" in capsys.readouterr().err and not (tmp_path / "no_template").exists()

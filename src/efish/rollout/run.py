@@ -21,7 +21,7 @@ from .measures import (
 
 
 def run_episodes(cfg: EfishConfig, policy, episodes: int, condition: str = "control", seed: int = 0,
-                 deterministic: bool = True, record_hidden: bool = False) -> dict[str, pd.DataFrame]:
+                 deterministic: bool = True, record_hidden: bool = False, members: int = 1) -> dict[str, pd.DataFrame]:
     """``episodes`` episodes in parallel arenas; returns the ``steps``, ``episodes`` and ``food`` tables
     (and ``hidden``, the policy's GRU state per step and agent, with ``record_hidden``).
 
@@ -37,12 +37,15 @@ def run_episodes(cfg: EfishConfig, policy, episodes: int, condition: str = "cont
     are discarded, and nothing else (actions, steps, food) depends on it.
 
     ``policy`` has ``initial_hidden(B, N)`` and ``act(obs, hidden, starts, deterministic)`` like
-    :class:`efish.rl.policy.Policy`.
+    :class:`efish.rl.policy.Policy`. ``members`` > 1 runs the episodes that many times side by side, as the
+    members of one env (:class:`~efish.env.vec_env.VecEnv`, each seeded by ``seed``): episode ``k * episodes +
+    e`` is member k's episode e, and ``policy`` acts for all of them (:class:`efish.rollout.group.PolicyGroup`).
     """
-    env = VecEnv(cfg, num_envs=episodes, seed=seed, autoreset=False)
+    env = VecEnv(cfg, num_envs=episodes, seed=[seed] * members, autoreset=False)
     obs = env.reset()
-    hidden, starts = policy.initial_hidden(episodes, env.n), np.ones(episodes)
-    T, B, N = cfg.env.episode_steps, episodes, env.n
+    B, N = env.num_envs, env.n
+    hidden, starts = policy.initial_hidden(B, N), np.ones(B)
+    T = cfg.env.episode_steps
     food = FoodLog(env)
     steps, states, bites_recv = [], [], np.zeros((B, N), int)
     running = np.ones(B, bool)  # arenas whose episode has not ended: only they are recorded
