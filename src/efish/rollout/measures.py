@@ -1,7 +1,7 @@
 """What the steps table records about each agent at each step, beyond the state itself: the inputs of the
 analyses (docs/methods/analyses.md), Fig 6's targets among them (docs/methods/analyses.md#decoding-variables).
 
-Pure numpy on an env's state after a step (or on the observation the step
+Functions of an env's state after a step (or of the observation the step
 returned): distances and bearings to the nearest bodies, the sizes of the
 nearest agents, food counts near the agent by sector, the realised turn, how
 many conspecifics the Knollenorgans hear and how many are within Knollenorgan
@@ -10,6 +10,12 @@ the analyses must not recompute (error angles of a homer against its target's
 local fields; log10 of the Mormyromast- and Ampullary-relevant fields at the
 body centre). Every function returns arrays [B, N] keyed by their column names
 (or one such array).
+
+The pairwise measures (nearest bodies, food counts, agents in range, the
+fields) loop over arena, agent and body in the numba kernels of
+:mod:`efish.rollout.measure_kernels`: they run at every step of an assay, and
+the numpy formulas, kept in :mod:`efish.rollout.measures_reference` as their
+tested twin, cost more than the simulation itself.
 
 The fields are the physics' own: the formulas of :mod:`efish.physics.fields`, the
 EOD monopoles and intrinsic moments of :mod:`efish.physics.reference`, and the
@@ -21,12 +27,20 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..env.geometry import nearest_pellet
 from ..env.vec_env import VecEnv
-from ..physics.fields import pairwise_dipole_field, pairwise_monopole_field
+from ..physics.fields import coulomb_constant, pairwise_dipole_field, pairwise_monopole_field
 from ..physics.plan import EffectPlan
 from ..physics.reference import eod_monopoles, intrinsic_moments
 from ..units import CM, wrap
+from .measure_kernels import (
+    FieldConstants,
+    count_within,
+    food_sectors,
+    log_fields_kernel,
+    nearest_agents,
+    nearest_food,
+    nearest_wall,
+)
 
 SECTORS = ("front", "left", "back", "right")  # bearing within pi/4 of 0, pi/2, pi, -pi/2
 
@@ -35,44 +49,23 @@ def nearest(env: VecEnv) -> dict[str, np.ndarray]:
     """Distance (cm) and bearing (rad, from the heading) to the nearest agent, pellet and wall; the distance to
     the second-nearest agent and the sizes of the nearest two (NaN where there is none)."""
     s = env.state
-    xy, h = s.xy, s.heading
-    d = xy[:, None, :, :] - xy[:, :, None, :]                       # [B, N(i), N(j), 2]: j - i
-    dist = np.linalg.norm(d, axis=-1) + np.where(np.eye(env.n, dtype=bool), np.inf, 0.0)
-    order = np.argsort(dist, axis=-1, kind="stable")
-    j = order[..., 0]
-    pick = np.take_along_axis(d, j[..., None, None], axis=2)[:, :, 0]
-    out = {"dist_agent_cm": dist.min(axis=-1), "bearing_agent_rad": wrap(np.arctan2(pick[..., 1], pick[..., 0]) - h)}
-    sizes = np.broadcast_to(s.size[:, None, :], dist.shape)
-    for rank, key in ((0, "1"), (1, "2")):
-        has = env.n > rank + 1
-        k = order[..., min(rank, env.n - 1)]
-        out[f"size_agent{key}"] = np.take_along_axis(sizes, k[..., None], -1)[..., 0] if has else np.full(h.shape, np.nan)
-    out["dist_agent2_cm"] = np.sort(dist, axis=-1)[..., 1] if env.n > 2 else np.full(h.shape, np.nan)
-    if env.n == 1:
-        out["dist_agent_cm"][:], out["bearing_agent_rad"][:] = np.nan, np.nan
-    dist_food, k = np.empty(h.shape), np.empty(h.shape, np.int64)
-    nearest_pellet(xy, s.pellet_xy, s.alive, dist_food, k)
-    pk = np.take_along_axis(s.pellet_xy, np.maximum(k, 0)[..., None], axis=1) - xy   # [B, N, 2]
-    out["dist_food_cm"] = dist_food
-    out["bearing_food_rad"] = np.where(k >= 0, wrap(np.arctan2(pk[..., 1], pk[..., 0]) - h), np.nan)
-    walls = np.stack([xy[..., 0], s.width[:, None] - xy[..., 0], xy[..., 1], s.height[:, None] - xy[..., 1]], -1)
-    w = walls.argmin(axis=-1)
-    out["dist_wall_cm"] = walls.min(axis=-1)
-    out["bearing_wall_rad"] = wrap(np.array([np.pi, 0.0, -np.pi / 2, np.pi / 2])[w] - h)
+    shape = s.heading.shape
+    out = {key: np.empty(shape) for key in ("dist_agent_cm", "bearing_agent_rad", "size_agent1", "size_agent2",
+                                             "dist_agent2_cm", "dist_food_cm", "bearing_food_rad", "dist_wall_cm",
+                                             "bearing_wall_rad")}
+    nearest_agents(s.xy, s.heading, s.size, out["dist_agent_cm"], out["bearing_agent_rad"], out["dist_agent2_cm"],
+                   out["size_agent1"], out["size_agent2"])
+    nearest_food(s.xy, s.heading, s.pellet_xy, s.alive, out["dist_food_cm"], out["bearing_food_rad"])
+    nearest_wall(s.xy, s.heading, s.width, s.height, out["dist_wall_cm"], out["bearing_wall_rad"])
     return out
 
 
 def food_counts(env: VecEnv, radius_cm: float = 5.0) -> dict[str, np.ndarray]:
     """Live pellets within ``radius_cm`` of each agent, in all and per sector of the bearing from the heading."""
     s = env.state
-    d = s.pellet_xy[:, None, :, :] - s.xy[:, :, None, :]             # [B, N, P, 2]
-    near = (np.einsum("bnpi,bnpi->bnp", d, d) <= radius_cm ** 2) & s.alive[:, None, :]
-    bearing = wrap(np.arctan2(d[..., 1], d[..., 0]) - s.heading[..., None])
-    sector = np.round(bearing / (np.pi / 2)).astype(int) % 4           # 0 front, 1 left, 2 back, 3 right
-    out = {"food_count_5cm": near.sum(-1)}
-    for k, name in enumerate(SECTORS):
-        out[f"food_{name}_5cm"] = (near & (sector == k)).sum(-1)
-    return out
+    counts = np.empty((1 + len(SECTORS), *s.heading.shape), np.int64)   # all, then one row per sector
+    food_sectors(s.xy, s.heading, s.pellet_xy, s.alive, float(radius_cm), counts)
+    return {"food_count_5cm": counts[0], **{f"food_{name}_5cm": counts[1 + k] for k, name in enumerate(SECTORS)}}
 
 
 def knollen_agents(knollen_block: np.ndarray, slots: int) -> np.ndarray:
@@ -89,10 +82,9 @@ def agents_in_range(env: VecEnv, range_cm: float) -> np.ndarray:
     those agents emitted on the step (:func:`knollen_agents` counts those
     heard, which also depends on their EODs).
     """
-    xy = env.state.xy
-    d = np.linalg.norm(xy[:, None, :, :] - xy[:, :, None, :], axis=-1)   # [B, N(i), N(j)]
-    others = ~np.eye(env.n, dtype=bool)
-    return ((d < range_cm) & others).sum(-1)
+    counts = np.empty(env.state.heading.shape, np.int64)
+    count_within(env.state.xy, float(range_cm), counts)
+    return counts
 
 
 def log_morm_sensed(morm_block: np.ndarray, e_min: float, e_max: float) -> np.ndarray:
@@ -178,19 +170,11 @@ def log_fields(env: VecEnv) -> dict[str, np.ndarray]:
     pellets only; -inf where the field is exactly 0.
     """
     s, plan, soft = env.state, env.plan, env.cfg.physics.softening_m
-    xy, h = s.xy * CM, s.heading
-    bodies = np.concatenate([xy, s.pellet_xy * CM], axis=1)             # [B, N + P, 2]
-    n = env.n
-    live = np.concatenate([np.ones(xy.shape[:2], bool), s.alive], axis=1)
-    is_agent = np.arange(bodies.shape[1]) < n
-    alpha = np.where(is_agent, plan.alpha_agent, plan.alpha_pellet)     # [N + P]
-    centre = xy[:, :, None, :]                                          # [B, N, 1, 2]
-    others = live[:, None, :] & ~np.eye(n, bodies.shape[1], dtype=bool)[None]
-    p_int = intrinsic_moments(h, s.pellet_phi, plan)                    # [B, N + P, 2]
-    field = {"softening": soft, "eps0": plan.eps0}
-    e_amp = pairwise_dipole_field(centre, bodies[:, None], p_int[:, None], **field)    # [B, N, N + P, 2]
-    e_eod = eod_field(plan, soft, xy[:, :, None, :], h[:, :, None], bodies[:, None])   # own EOD at every body
-    e_morm = pairwise_dipole_field(centre, bodies[:, None], alpha[:, None] * e_eod, **field)
-    with np.errstate(divide="ignore"):
-        return {name: np.log10(np.linalg.norm((e * others[..., None]).sum(2), axis=-1))
-                for name, e in (("log_amp_field", e_amp), ("log_morm_field", e_morm))}
+    consts = FieldConstants(k=coulomb_constant(plan.eps0), eod_charge=plan.eod_charge,
+                            half_sep=plan.eod_half_separation, agent_dipole=plan.agent_dipole,
+                            pellet_dipole=plan.pellet_dipole, alpha_agent=plan.alpha_agent,
+                            alpha_pellet=plan.alpha_pellet, soft2=soft * soft)
+    out = {"log_amp_field": np.empty(s.heading.shape), "log_morm_field": np.empty(s.heading.shape)}
+    log_fields_kernel(s.xy * CM, s.heading, s.pellet_xy * CM, s.pellet_phi, s.alive, consts,
+                      out["log_amp_field"], out["log_morm_field"])
+    return out
