@@ -54,3 +54,16 @@ def test_a_user_cache_dir_wins(monkeypatch):
     monkeypatch.setattr(numba.config, "CACHE_DIR", "unchanged")
     assert _numba_cache.configure() is None
     assert numba.config.CACHE_DIR == "unchanged"
+
+
+def test_every_module_that_defines_kernels_keys_the_cache():
+    """A module that imports efish's njit defines kernels: its source must be in the cache's key."""
+    covered = set()
+    for entry in _numba_cache.KERNEL_SOURCES:
+        path = _numba_cache.PACKAGE / entry
+        covered |= set(path.rglob("*.py")) if path.is_dir() else {path}
+    defining = {p for p in _numba_cache.PACKAGE.rglob("*.py")
+                if "from ._jit import njit" in p.read_text() or "from .._jit import njit" in p.read_text()
+                or "from ..._jit import njit" in p.read_text()}
+    assert defining, "no kernel module found: the test's import pattern is stale"
+    assert not sorted(str(p.relative_to(_numba_cache.PACKAGE)) for p in defining - covered)

@@ -4,8 +4,8 @@ numba's on-disk cache (``cache=True``) checks only the source file of the
 function it compiled; when a helper it inlines from another file changes, it
 would load stale machine code. So the cache folder is keyed by a hash of every
 file a kernel can be compiled from: the packages that define or inline
-kernels (``physics``, ``sensors``, ``env``), the benchmark module that
-defines its own, and this cache's own modules. Editing an analysis, a figure
+kernels (``physics``, ``sensors``, ``env``), the rollout's and the benchmark's
+modules that define their own, and this cache's own modules. Editing an analysis, a figure
 or the CLI keeps the compiled kernels (rebuilding them takes minutes); editing
 a physics module starts from a fresh folder.
 """
@@ -19,7 +19,8 @@ from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parent
 #: Folders and files (relative to the package) that kernels are compiled from or inline.
-KERNEL_SOURCES = ("physics", "sensors", "env", "bench/multipole.py", "_jit.py", "_numba_cache.py")
+KERNEL_SOURCES = ("physics", "sensors", "env", "rollout/measure_kernels.py", "bench/multipole.py", "_jit.py",
+                  "_numba_cache.py")
 
 
 def _digest(files: Iterable[Path]) -> str:
