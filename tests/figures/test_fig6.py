@@ -38,8 +38,8 @@ def test_decoding_bars_are_the_skills_best_first_without_unscored_targets(record
     ax = draw("fig6/E", {"decoding": table, **recorded("wide2")})
     widths = [p.get_width() for p in ax.patches if p.get_height() > 0]
     np.testing.assert_allclose(widths, [0.6, 0.2, -0.1])
-    assert [t.get_text() for t in ax.get_yticklabels()] == ["nearest agent: distance", "wall: distance",
-                                                            "food: distance"]
+    assert [t.get_text() for t in ax.get_yticklabels()] == ["nearest agent: log distance", "wall: log distance",
+                                                            "food: log distance"]
 
 
 @pytest.mark.parametrize("with_column", [True, False])
@@ -54,7 +54,7 @@ def test_readouts_are_drawn_hatched_below_the_sensed_targets_and_not_ranked_amon
     ax = draw("fig6/E", {"decoding": table if with_column else table.drop(columns="readout"), **recorded("wide2")})
     bars = [p for p in ax.patches if p.get_height() > 0]
     np.testing.assert_allclose([p.get_width() for p in bars], [0.3, 0.1, 0.8, 0.6, 0.5])
-    assert [t.get_text() for t in ax.get_yticklabels()] == ["nearest agent: distance", "wall: distance",
+    assert [t.get_text() for t in ax.get_yticklabels()] == ["nearest agent: log distance", "wall: log distance",
                                                             "turn (readout)", "own EOD (readout)",
                                                             "log reading (M, sensed) (readout)"]
     assert [bool(p.get_hatch()) for p in bars] == [False, False, True, True, True]
@@ -76,7 +76,7 @@ def test_food_decoding_bars_pair_near_and_far_skills_per_variable(recorded, anal
     ax = draw("fig6/F", {"food_decoding": table, **wide2})
     widths = sorted(p.get_width() for p in ax.patches if p.get_height() > 0 and np.isfinite(p.get_width()))
     np.testing.assert_allclose(widths, [-0.05, 0.3, 0.5])
-    assert {t.get_text() for t in ax.get_yticklabels()} == {"food: distance", "food: bearing"}
+    assert {t.get_text() for t in ax.get_yticklabels()} == {"food: log distance", "food: bearing"}
     assert [t.get_text() for t in ax.get_legend().get_texts()] == ["near", "far"]
     empty = draw("fig6/F", {"food_decoding": table.assign(skill=np.nan), **wide2})
     assert any("fewer than 2 groups" in t for t in texts(empty))

@@ -46,14 +46,15 @@ KNOLLENORGAN_STATE = {"K": "K on", "noK": "K off"}
 KNOLLENORGAN_COLOURS = {"K on": RECEPTOR_COLOURS["knollenorgan"], "K off": NEUTRAL_COLOUR}
 KNOLLENORGAN_STYLES = {"K on": "-", "K off": "--"}
 #: Readable names of the decoding targets (steps columns, efish.analysis.decoding.DECODE_TARGETS; a few older
-#: targets too, so that the tables of earlier runs still draw with names).
+#: targets too, so that the tables of earlier runs still draw with names). Distances are decoded as their log10
+#: (efish.analysis.decoding.LOG_DISTANCES), and their names say so.
 TARGET_LABELS = {
-    "dist_agent_cm": "nearest agent: distance", "bearing_agent_rad": "nearest agent: bearing",
-    "dist_agent2_cm": "2nd agent: distance", "size_agent1": "nearest agent: size",
+    "dist_agent_cm": "nearest agent: log distance", "bearing_agent_rad": "nearest agent: bearing",
+    "dist_agent2_cm": "2nd agent: log distance", "size_agent1": "nearest agent: size",
     "size_agent2": "2nd agent: size", "n_knollen_agents": "agents heard (K)",
     "n_agents_100cm": "agents in K range (100 cm)",
-    "dist_food_cm": "food: distance", "bearing_food_rad": "food: bearing", "food_count_5cm": "pellets within 5 cm",
-    "dist_wall_cm": "wall: distance", "bearing_wall_rad": "wall: bearing", "size": "own size", "eod": "own EOD",
+    "dist_food_cm": "food: log distance", "bearing_food_rad": "food: bearing", "food_count_5cm": "pellets within 5 cm",
+    "dist_wall_cm": "wall: log distance", "bearing_wall_rad": "wall: bearing", "size": "own size", "eod": "own EOD",
     "turn_rad": "turn", "log_morm_field": "log field (M, geometric)", "log_morm_sensed": "log reading (M, sensed)",
     "log_amp_field": "log field (A)", "knollen_spikes": "K inputs spiking", "err_knollen_rad": "error angle (K)",
     "err_morm_rad": "error angle (M)", "err_amp_rad": "error angle (A)",
