@@ -40,6 +40,7 @@
     efish bench multipole [overrides] [--orders P ..] [--width CM]   would cell multipoles make the far field cheaper?
     efish bench env [overrides] [--envs N] [--steps N] [--json]   env-only throughput, fast vs reference physics
     efish bench train [overrides] [--hidden W ..] [--json]   rollout/update speed, model-FLOP utilisation
+    efish bench group [overrides] [--sizes K ..] [--json]    grouped rollouts against one by one
     efish bench budget [overrides] [--minutes M] [--hidden W ..] [--seeds N] [--jobs N] [--out D]
                                               fixed training time: wider net, more steps or more seeds?
     efish bench pipeline [--results D]        time per rule family of a pipeline run (Snakemake benchmarks)
@@ -412,6 +413,9 @@ BENCH_STUDIES = {
     "scaling": ("cost per agent-step against pellets and agents: table and figure",
                 "Measure the cost of an agent-step as pellets and agents are added. Writes bench_scaling.parquet "
                 "(--out) and its figure as PNG and PDF (--figures), each with config.yaml and provenance."),
+    "group": ("grouped rollouts: K policies on the same episodes in one env against one by one",
+              "Time K untrained policies running the same assay episodes one by one and grouped in one env "
+              "(efish assay --group), for each group size. Prints a table (or JSON); writes nothing."),
     "multipole": ("cell multipoles against direct far-field reads at the plan's accuracy",
                   "Would cell multipoles make the far field cheaper? Compares them with direct far-field reads at "
                   "the plan's accuracy, for each expansion order. Prints a table (or JSON); writes nothing."),
@@ -457,6 +461,12 @@ def _bench_parsers(sub: argparse._SubParsersAction) -> None:
     bb.add_argument("--jobs", type=int, help="runs at a time, one thread each (default bench.budget_jobs)")
     _add_out(bb, "also write bench_budget.parquet (+ config, provenance) here")
     bb.set_defaults(handler=_bench_budget, recipe=TRAINING_RECIPE)
+    bg = _bench_command(bsub, "group", "docs/methods/assays.md#grouped-rollouts")
+    _add_json(bg)
+    bg.add_argument("--sizes", type=int, nargs="+", help="policies per group (default bench.group_sizes)")
+    bg.add_argument("--episodes", type=int, help="episodes per policy (default bench.group_episodes)")
+    bg.add_argument("--steps", type=int, help="steps per episode (default bench.group_steps)")
+    bg.set_defaults(handler=_bench_group)
     bpl = _bench_command(bsub, "pipeline")
     bpl.add_argument("--results", type=Path, help="results folder of the run (default results/{run})")
     _add_json(bpl)
@@ -775,6 +785,14 @@ def _bench_train(args, cfg, started) -> None:
         cfg = dataclasses.replace(cfg, train=dataclasses.replace(cfg.train, device=pick_device(args.device)))
     rows = bench_train(_with_bench(cfg, train_hidden=args.hidden), progress=lambda line: _stderr(f"bench train: {line}"))
     print(json.dumps(rows, indent=2) if args.json else format_train(rows))
+
+
+def _bench_group(args, cfg, started) -> None:
+    from .bench.group import bench_group, format_group
+
+    rows = bench_group(_with_bench(cfg, group_sizes=args.sizes, group_episodes=args.episodes,
+                                   group_steps=args.steps), args.overrides)
+    print(json.dumps(rows, indent=2) if args.json else format_group(rows))
 
 
 def _bench_budget(args, cfg, started) -> None:

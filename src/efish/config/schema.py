@@ -384,6 +384,10 @@ class BenchConfig:
     budget_hidden: list = param([64, 128], "bench budget: network widths trained (--hidden)")
     budget_seeds: int = param(2, "bench budget: seeds per width (--seeds)", lo=1)
     budget_jobs: int = param(2, "bench budget: runs at a time, one thread each (--jobs)", lo=1)
+    group_assay: str = param("patchy4", "bench group: the assay whose first condition the policies run")
+    group_sizes: list = param([1, 2, 4], "bench group: policies per group timed (--sizes)")
+    group_episodes: int = param(6, "bench group: episodes per policy (--episodes)", lo=1)
+    group_steps: int = param(400, "bench group: steps per episode (--steps)", lo=1)
     multipole_orders: list = param([4, 6, 8], "bench multipole: expansion orders compared (--orders)")
     multipole_width_cm: float = param(560.0, "bench multipole: square arena side of the scene, cm (--width)", lo=0.0)
 
