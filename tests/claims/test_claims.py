@@ -466,7 +466,10 @@ CONSTANT_HEADLINE = {"C13"}
 
 # -------------------------------------------------------------------- tests
 def test_the_registry_lists_the_claims_of_the_docs_in_the_paper_order():
-    listed = re.findall(r"^\| \[(C\d+)\]\(#c\d+\) \|", (REPO / "docs/claims/index.md").read_text(), re.M)
+    text = (REPO / "docs/claims/index.md").read_text()
+    # the table of smallest effects has a row per part, not per claim: the list of claims is every other table
+    text = re.sub(r"^## Smallest effects of interest.*?(?=^## )", "", text, flags=re.M | re.S)
+    listed = re.findall(r"^\| \[(C\d+)\]\(#c\d+\) \|", text, re.M)
     assert listed and list(cl.CLAIMS) == listed
     assert [int(c[1:]) for c in cl.CLAIMS] == sorted(int(c[1:]) for c in cl.CLAIMS)
 
