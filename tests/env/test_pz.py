@@ -57,7 +57,7 @@ def test_state_is_every_observation_in_id_order_before_and_after_the_end():
 
 
 def test_state_is_agent_zeros_row_of_the_critic_input():
-    from efish.rl.train import agent_centric_state
+    from efish.rl.collect import agent_centric_state
 
     env = parallel_env(**SHORT)
     obs, _ = env.reset(seed=0)

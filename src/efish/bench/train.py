@@ -103,7 +103,8 @@ def update_rate(cfg: EfishConfig, obs_dim: int, n_agents: int, sequences: int, s
 def rollout_rate(cfg: EfishConfig, steps: int, device: torch.device) -> float:
     """Env-steps/s (arena steps x arenas) of collecting a rollout with an untrained policy on ``device``."""
     from ..env.vec_env import VecEnv
-    from ..rl.train import Learner, collect, initial_carry
+    from ..rl.collect import collect, initial_carry
+    from ..rl.train import Learner
 
     t = dataclasses.replace(cfg.train, rollout_steps=steps, chunk=steps)
     run = dataclasses.replace(cfg, train=t)

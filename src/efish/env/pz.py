@@ -118,7 +118,7 @@ class EfishParallelEnv(ParallelEnv):
         """The global state for a centralised critic, float32[N * D] in ``state_space``: every agent's last
         observation concatenated in id order (``fish_0`` first).
 
-        This is agent 0's row of :func:`efish.rl.train.agent_centric_state`, the critic input of efish's own
+        This is agent 0's row of :func:`efish.rl.collect.agent_centric_state`, the critic input of efish's own
         MAPPO, which gives every agent a view of its own (its own observation first, then the others'): apply that
         function to the stacked observations for the per-agent views. After the last step it is the state the episode ended in, as PettingZoo's state test
         expects; before ``reset()`` there is none.

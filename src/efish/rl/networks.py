@@ -62,20 +62,19 @@ class RecurrentTrunk(nn.Module):
         norm, first = self.mlp[0], self.mlp[1]
         return F.linear(z, first.weight * norm.weight, torch.addmv(first.bias, first.weight, norm.bias))
 
-    def forward(self, x: torch.Tensor, h: torch.Tensor, starts: torch.Tensor, standardized: bool = False
-                ) -> tuple[torch.Tensor, torch.Tensor]:
-        """x [T, B, D] (already :meth:`standardize`-d when ``standardized``), h [B, H] before the chunk, starts
-        [T, B] (1 where an episode begins).
-
-        Returns features [T, B, H] and the hidden state after the chunk [B, H].
-        """
+    def hidden_states(self, x: torch.Tensor, h: torch.Tensor, starts: torch.Tensor, standardized: bool = False
+                      ) -> tuple[torch.Tensor, torch.Tensor]:
+        """The GRU's hidden state after each step: x [T, B, D] (already :meth:`standardize`-d when
+        ``standardized``), h [B, H] before the chunk, starts [T, B] (1 where an episode begins) -> [T, B, H], and
+        the last of them [B, H]. A rollout reads them to bootstrap a truncated episode from the hidden state of its
+        step (:func:`efish.rl.collect.collect`)."""
         z = x if standardized else self.standardize(x)
         feats = self.mlp[2:](self.input_layer(z))
         keep = (1.0 - starts.to(feats.dtype)).unsqueeze(-1)
         if x.shape[0] == 1:  # a rollout step: the GRU cell gives the same numbers without nn.GRU's overhead
             g = self.gru
             h = torch.gru_cell(feats[0], h * keep[0], g.weight_ih_l0, g.weight_hh_l0, g.bias_ih_l0, g.bias_hh_l0)
-            return self.out_norm(h.unsqueeze(0)), h
+            return h.unsqueeze(0), h
         # One fused GRU call per stretch without episode starts (in training usually the whole
         # chunk); the hidden state is zeroed where a sequence starts, as a step-by-step loop would.
         cuts = torch.nonzero(starts.any(dim=1)).flatten().tolist()
@@ -85,7 +84,17 @@ class RecurrentTrunk(nn.Module):
             out, h_next = self.gru(feats[a:b], (h * keep[a]).unsqueeze(0))
             h = h_next.squeeze(0)
             outs.append(out)
-        return self.out_norm(torch.cat(outs)), h
+        return torch.cat(outs), h
+
+    def forward(self, x: torch.Tensor, h: torch.Tensor, starts: torch.Tensor, standardized: bool = False
+                ) -> tuple[torch.Tensor, torch.Tensor]:
+        """x [T, B, D] (already :meth:`standardize`-d when ``standardized``), h [B, H] before the chunk, starts
+        [T, B] (1 where an episode begins).
+
+        Returns features [T, B, H] and the hidden state after the chunk [B, H].
+        """
+        states, h = self.hidden_states(x, h, starts, standardized)
+        return self.out_norm(states), h
 
 
 class Actor(nn.Module):
@@ -119,3 +128,10 @@ class Critic(nn.Module):
         """state [T, B, N*D] -> values [T, B], final hidden [B, H] (``standardized`` as for the actor)."""
         feats, h = self.trunk(state, h, starts, standardized)
         return self.head(feats).squeeze(-1), h
+
+    def values_along(self, state: torch.Tensor, h: torch.Tensor, starts: torch.Tensor
+                     ) -> tuple[torch.Tensor, torch.Tensor]:
+        """state [T, B, N*D] -> values [T, B] and the hidden state after each step [T, B, H]: a whole rollout's
+        values in one pass, the same numbers as stepping through it (up to rounding)."""
+        states, _ = self.trunk.hidden_states(state, h, starts)
+        return self.head(self.trunk.out_norm(states)).squeeze(-1), states

@@ -24,7 +24,6 @@ import math
 import time
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 import torch
 
@@ -38,11 +37,10 @@ from ..config.schema import (
 from ..env.vec_env import VecEnv
 from ..io import atomic_path, remove_partial_writes
 from ..layout import FINAL_POLICY, TRAINING_METRICS, stage_file
-from ..physics.geometry import conspecific_slots
-from .advantages import gae
+from .collect import carry_to, collect, initial_carry
 from .compute import Compute, resolve_compute, resolve_device
 from .loggers import Loggers, check_loggers
-from .mappo import Rollout, ppo_update
+from .mappo import ppo_update
 from .networks import Actor, Critic
 from .value_norm import ValueNormalizer
 
@@ -52,13 +50,6 @@ FINAL = FINAL_POLICY  # the finished run: what the pipeline declares as the trai
 METRICS = TRAINING_METRICS
 STAGE_COPIES = "stage_copies"  # checkpoint key: {k: stage file contents} of the stages the run has passed
 CPU = torch.device("cpu")
-
-
-def agent_centric_state(obs: np.ndarray) -> np.ndarray:
-    """[B, N, D] -> [B, N, N*D]: each agent's critic input, its own observation first, then the others in id order."""
-    n = obs.shape[1]
-    order = np.concatenate([np.arange(n)[:, None], conspecific_slots(n)], axis=1)
-    return obs[:, order].reshape(obs.shape[0], n, -1)
 
 
 class Learner:
@@ -75,86 +66,6 @@ class Learner:
         self.actor_opt = torch.optim.Adam(self.actor.parameters(), lr=t.lr, eps=t.adam_eps, weight_decay=t.weight_decay)
         self.critic_opt = torch.optim.Adam(self.critic.parameters(), lr=t.lr, eps=t.adam_eps, weight_decay=t.weight_decay)
         self.architecture = {"obs_dim": obs_dim, "n_agents": n_agents, "hidden": t.hidden}
-
-
-def initial_carry(obs: np.ndarray, hidden: int, device: torch.device = CPU) -> dict:
-    """What a rollout hands to the next: the last observation [B, N, D], both networks' hidden states [B*N, H],
-    episode starts and the running episode return [B*N] (all episodes start now). Tensors live on ``device``."""
-    s = obs.shape[0] * obs.shape[1]
-    return {"obs": obs, "h_actor": torch.zeros(s, hidden, device=device),
-            "h_critic": torch.zeros(s, hidden, device=device), "starts": torch.ones(s, device=device),
-            "episode_return": np.zeros(s)}
-
-
-def carry_to(carry: dict, device: torch.device) -> dict:
-    """The carry with its tensors on ``device`` (a checkpoint stores them on the CPU)."""
-    return {k: v.to(device) if isinstance(v, torch.Tensor) else v for k, v in carry.items()}
-
-
-def collect(cfg: EfishConfig, env: VecEnv, learner: Learner, carry: dict, generator: torch.Generator
-            ) -> tuple[Rollout, dict]:
-    """Step the env ``rollout_steps`` times with the current policy; returns the rollout (on the learner's device)
-    and episode stats. ``generator`` is a CPU generator: actions are sampled with it whatever the device."""
-    t_cfg = cfg.train
-    T, L, B, N = t_cfg.rollout_steps, t_cfg.chunk, env.num_envs, env.n
-    S = B * N
-    dev = learner.device
-
-    def tensor(a: np.ndarray, dtype: torch.dtype | None = None) -> torch.Tensor:
-        return torch.as_tensor(a, dtype=dtype).to(dev)
-    obs_np, h_a, h_c, starts_now = carry["obs"], carry["h_actor"], carry["h_critic"], carry["starts"]
-    buf = {k: [] for k in ("obs", "state", "actions", "logp", "values", "rewards", "terminated", "truncated",
-                           "starts", "next_values")}
-    h_actor_chunks, h_critic_chunks, returns_done, parts = [], [], [], {}
-    with torch.no_grad():
-        for t in range(T):
-            if t % L == 0:
-                h_actor_chunks.append(h_a.clone())
-                h_critic_chunks.append(h_c.clone())
-            obs = tensor(obs_np.reshape(1, S, -1))
-            state = tensor(agent_centric_state(obs_np).reshape(1, S, -1))
-            dist, h_a, _ = learner.actor(obs, h_a, starts_now[None])
-            values, h_c = learner.critic(state, h_c, starts_now[None])
-            actions = dist.sample(generator)
-            next_obs, reward, term, trunc, info = env.step(actions.reshape(B, N, 4).cpu().numpy())
-            done = np.repeat(term | trunc, N)
-            next_values = torch.zeros(S, device=dev)
-            if trunc.any():  # bootstrap truncated episodes from their final observation
-                final = info["final_obs"]
-                fs = tensor(agent_centric_state(final).reshape(1, S, -1))
-                nv, _ = learner.critic(fs, h_c, torch.zeros(1, S, device=dev))
-                next_values = learner.value_norm.denormalize(nv[0])
-            for k, v in (("obs", obs[0]), ("state", state[0]), ("actions", actions[0]), ("logp", dist.log_prob(actions)[0]),
-                         ("values", values[0]), ("rewards", tensor(reward.reshape(S), torch.float32)),
-                         ("terminated", tensor(np.repeat(term, N))),
-                         ("truncated", tensor(np.repeat(trunc, N))), ("starts", starts_now),
-                         ("next_values", next_values)):
-                buf[k].append(v)
-            for name, v in info["reward_parts"].items():
-                parts[name] = parts.get(name, 0.0) + float(v.mean())
-            carry["episode_return"] += reward.reshape(S)
-            if done.any():
-                returns_done += carry["episode_return"][done].tolist()
-                carry["episode_return"][done] = 0.0
-            starts_now = tensor(done, torch.float32)
-            obs_np = next_obs
-        # V(s_{t+1}) within the episode: the next step's value, or the bootstrap at truncation
-        last_state = tensor(agent_centric_state(obs_np).reshape(1, S, -1))
-        last_value, _ = learner.critic(last_state, h_c, starts_now[None])
-    data = {k: torch.stack(v) for k, v in buf.items()}
-    values_dn = learner.value_norm.denormalize(data["values"])
-    following = torch.cat([values_dn[1:], learner.value_norm.denormalize(last_value)])
-    next_v = torch.where(data["truncated"], data["next_values"], following)
-    adv, ret = gae(data["rewards"], values_dn, next_v, data["terminated"], data["truncated"], t_cfg.gamma,
-                   t_cfg.gae_lambda)
-    carry.update(obs=obs_np, h_actor=h_a, h_critic=h_c, starts=starts_now)
-    ro = Rollout(obs=data["obs"], state=data["state"], actions=data["actions"], logp=data["logp"], values=data["values"],
-                 advantages=adv, returns=ret, starts=data["starts"], h_actor=torch.stack(h_actor_chunks),
-                 h_critic=torch.stack(h_critic_chunks))
-    episode = {"episode_return": float(np.mean(returns_done)) if returns_done else float("nan"),
-               "episodes_ended": len(returns_done),
-               **{f"reward_{k}": v / T for k, v in parts.items()}}
-    return ro, episode
 
 
 def train(cfg: EfishConfig, out_dir: str | Path, progress=None, restart: bool = False) -> pd.DataFrame:
