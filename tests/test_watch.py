@@ -13,7 +13,8 @@ from efish.cli import main
 from efish.config import compose
 from efish.layout import Run, seed_name, training_folder
 from efish.rl.train import train
-from efish.watch import Job, duration, job_row, read_metrics
+from efish.run_plan import RunPlan
+from efish.watch import RETURN_WINDOW, SMOOTHED, Job, curve_columns, duration, job_row, read_metrics, task_groups
 
 from .helpers import Killed, kill_at
 from .rl.test_train import tiny
@@ -53,7 +54,7 @@ def test_the_eta_is_the_updates_left_at_the_recent_speed(tmp_path):
     metrics.to_parquet(tmp_path / "metrics.parquet")
     row = job_row(job, read_metrics(job), now=0.0)
     # 2 updates of 100 env steps left at 50 env steps/s; the last update ended no episode: the one before's return
-    assert (row["state"], row["update"], row["ETA"], row["return"]) == ("running", "2/4", "4s", "1.500")
+    assert (row["state"], row["update"], row["ETA"], row[SMOOTHED]) == ("running", "2/4", "4s", "1.500")
     assert job_row(job, None, now=0.0)["state"] == "not started"
 
 
@@ -61,19 +62,57 @@ def test_durations_read_at_a_glance():
     assert [duration(s) for s in (42, 185, 7620, float("nan"))] == ["42s", "3m05s", "2h07m", "?"]
 
 
-def test_a_shipped_scale_lists_the_seeds_not_started_with_their_updates(tmp_path, capsys):
+def test_a_shipped_scale_counts_every_planned_job_from_the_first_call(tmp_path, capsys):
+    """Before any job has started the table lists every seed and every policy recipe the run plan trains, each
+    with its updates, so the job count does not grow when a recipe's job starts."""
     (tmp_path / "smoke").mkdir()
     cfg = compose(["scale=smoke", "policy=foraging"]).train
     updates = max(1, cfg.total_steps // (cfg.rollout_steps * cfg.num_envs))
-    lines = watch_lines(capsys, "smoke", "--results", str(tmp_path), "--once")[2:]
+    title, _, *lines = watch_lines(capsys, "smoke", "--results", str(tmp_path), "--once")
     seeds = compose(["scale=smoke"]).scale.seed_numbers()
-    assert [line.split()[:4] for line in lines] == [[f"seed_{s}", "not", "started", f"0/{updates}"] for s in seeds]
+    recipes = sorted({p for assay in RunPlan.from_config({"scale": "smoke"}).assays
+                      for p in RunPlan.from_config({"scale": "smoke"}).assay_policies[assay]} - {"selected"})
+    assert recipes, "the smoke scale acts with at least one policy recipe (homing)"
+    assert [line.split()[:4] for line in lines[:len(seeds)]] == [[f"seed_{s}", "not", "started", f"0/{updates}"]
+                                                                 for s in seeds]
+    assert [line.split()[0] for line in lines[len(seeds):]] == recipes
+    assert all(line.split()[3] != "0/?" for line in lines), lines  # every recipe's updates from its config
+    assert f"0/{len(seeds) + len(recipes)} training jobs finished" in title
 
 
-def test_plot_writes_a_png(results, tmp_path, capsys):
+def test_the_return_is_smoothed_over_the_last_finite_returns(tmp_path):
+    job = Job("seed_1", tmp_path)
+    returns = [float(r) for r in range(1, 13)] + [float("nan"), -50.0]  # a bad last update after a good run
+    metrics = pd.DataFrame({"update": range(1, 15), "total_updates": 20, "env_steps": range(100, 1500, 100),
+                            "episode_return": returns, "entropy": 0.5, "approx_kl": 0.01,
+                            "env_steps_per_s": [50.0] * 13 + [5.0]})  # the last update under heavy load
+    metrics.to_parquet(tmp_path / "metrics.parquet")
+    row = job_row(job, read_metrics(job), now=0.0)
+    window = [r for r in returns if r == r][-RETURN_WINDOW:]
+    assert row[SMOOTHED] == f"{sum(window) / len(window):.3f}" and row["last return"] == "-50.000"
+    assert row["ETA"] == "12s"  # 6 updates x 100 steps at the median 50 steps/s, not the last update's 5
+
+
+def test_plot_draws_every_metric_with_a_title_and_each_task_on_its_own_axes(results, tmp_path, capsys, monkeypatch):
+    drawn = {}
+    real = watch_module.plot_curves
+
+    def spy(metrics, path, title=""):
+        drawn.update(metrics=metrics, title=title)
+        real(metrics, path, title)
+
+    monkeypatch.setattr(watch_module, "plot_curves", spy)
     png = tmp_path / "curves.png"
     watch_lines(capsys, RUN, "--results", str(results), "--once", "--plot", str(png))
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert drawn["title"].startswith(f"{RUN}: training curves (")
+    columns = curve_columns(drawn["metrics"])
+    for column in ("episode_return", "policy_loss", "value_loss", "explained_variance", "env_steps_per_s",
+                   "entropy", "approx_kl", "clip_fraction"):
+        assert column in columns, column
+    assert not set(columns) & {"update", "env_steps", "wall_s", "total_updates"}
+    assert task_groups(["seed_2", "homing", "seed_10", "homing_raycast"]) == {
+        "foraging seeds": ["seed_2", "seed_10"], "homing": ["homing"], "homing_raycast": ["homing_raycast"]}
 
 
 def test_the_live_table_refreshes_until_ctrl_c(results, capsys, monkeypatch):

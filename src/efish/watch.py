@@ -5,9 +5,14 @@ A job is a folder under ``results/<run>/train/``: a foraging seed (``seed_N``) o
 (``homing``). Its state comes from its files: finished once final.pt is there, running while it has
 metrics.parquet and no final.pt (a killed job looks running too: its last update's age says it is not), not
 started before its first update. Training rewrites metrics.parquet atomically after every update, so reading it
-while a job runs is safe. When the run is a shipped scale (``results/smoke``, no overrides), the scale's config
-also gives the seeds that have not started yet and each job's updates where its metrics do not record them;
-for any other run those come from the job folders and their metrics alone.
+while a job runs is safe. When the run is a shipped scale (``results/smoke``, no overrides), its run plan
+(:class:`efish.run_plan.RunPlan`) also gives the jobs that have not started yet (the seeds and every policy
+recipe its assays act with), so the job count is right from the first call, and each job's updates where its
+metrics do not record them; for any other run those come from the job folders and their metrics alone.
+
+The table's return is smoothed (:data:`RETURN_WINDOW`): one update's mean return swings with the few episodes
+that ended in it, so the last one alone misranks seeds. The ETA divides the steps left by the job's median
+speed over all its updates, which a burst of load on the machine does not move.
 """
 
 from __future__ import annotations
@@ -26,10 +31,17 @@ from .io import atomic_path, read_parquet
 from .layout import FINAL_POLICY, TRAINING_METRICS, Run, seed_name, training_folder
 
 NOT_STARTED, RUNNING, FINISHED = "not started", "running", "finished"
-RATE_ROWS = 10  # the ETA's speed: the mean env steps per second over this many last updates
+#: The table's return: the mean of this many last finite episode returns (updates where no episode ended have none).
+RETURN_WINDOW = 10
+SMOOTHED = f"return ({RETURN_WINDOW})"  # the table's column of the smoothed return, named with its window
 FORAGING_RECIPE = "foraging"  # config/policy/: what the seeds train on (the policy recipes have folders of their own)
-#: The curves of ``--plot``: metrics column -> axis label.
-CURVES = {"episode_return": "mean episode return", "entropy": "policy entropy", "approx_kl": "approximate KL"}
+#: Metrics columns ``--plot`` does not draw: the x axis and the bookkeeping.
+NOT_CURVES = ("update", "total_updates", "env_steps", "wall_s")
+#: Axis labels of the curves whose column name does not say enough; every other numeric column is drawn as named.
+CURVE_LABELS = {"episode_return": "mean episode return", "entropy": "policy entropy", "approx_kl": "approximate KL",
+                "env_steps_per_s": "env steps / s", "episodes_ended": "episodes ended per update"}
+#: Panels per row of the plot.
+PANELS_PER_ROW = 5
 
 
 @dataclass(frozen=True)
@@ -56,13 +68,19 @@ def training_jobs(run: Run) -> list[Job]:
     return [Job(name, run.path(training_folder(name)), updates[name]) for name in names]
 
 
-def planned_updates(run_name: str) -> dict[str, int]:
-    """Seed folder -> updates, of every seed a shipped scale trains; {} for another run (its overrides, which may
-    change both, are not recorded in its name)."""
+def planned_updates(run_name: str) -> dict[str, int | None]:
+    """Job folder -> updates, of every job a shipped scale trains: its seeds and the policy recipes its assays act
+    with (the run plan's training targets); {} for another run (its overrides, which may change both, are not
+    recorded in its name)."""
     if not _is_shipped_scale(run_name):
         return {}
+    from .run_plan import RunPlan  # the plan composes every assay: only for a shipped scale
+
     cfg = compose([f"scale={run_name}", f"policy={FORAGING_RECIPE}"])
-    return {seed_name(seed): cfg.train.total_updates() for seed in cfg.scale.seed_numbers()}
+    seeds = {seed_name(seed): cfg.train.total_updates() for seed in cfg.scale.seed_numbers()}
+    targets = RunPlan.from_config({"scale": run_name}).training_targets(Run(run_name))
+    recipes = [Path(t).parent.name for t in targets if Path(t).parent.name not in seeds]
+    return {**seeds, **{name: _recipe_updates(run_name, name) for name in recipes}}
 
 
 def _recipe_updates(run_name: str, name: str) -> int | None:
@@ -101,16 +119,18 @@ def job_row(job: Job, metrics: pd.DataFrame | None, now: float) -> dict:
     if metrics is None or metrics.empty:
         total = job.planned_updates
         return {"job": job.name, "state": NOT_STARTED, "update": f"0/{_or_unknown(total)}", "env steps": "0",
-                "return": "-", "entropy": "-", "KL": "-", "env-steps/s": "-", "ETA": "-", "last update": "-"}
+                SMOOTHED: "-", "last return": "-", "entropy": "-", "KL": "-", "env-steps/s": "-", "ETA": "-",
+                "last update": "-"}
     last = metrics.iloc[-1]
     update = int(last["update"])
     total = _total_updates(metrics, job, finished)
     returns = metrics["episode_return"].dropna()  # NaN where no episode ended in an update
-    rate = metrics["env_steps_per_s"].tail(RATE_ROWS).mean()
+    rate = metrics["env_steps_per_s"].median()  # the job's steady speed: a burst of load does not move it
     age = max(0.0, now - metrics.attrs.get("written", now))  # a clock a little behind the file server's
     return {"job": job.name, "state": FINISHED if finished else RUNNING, "update": f"{update}/{_or_unknown(total)}",
             "env steps": f"{int(last['env_steps']):,}",
-            "return": f"{returns.iloc[-1]:.3f}" if len(returns) else "-",
+            SMOOTHED: f"{returns.tail(RETURN_WINDOW).mean():.3f}" if len(returns) else "-",
+            "last return": f"{returns.iloc[-1]:.3f}" if len(returns) else "-",
             "entropy": f"{last['entropy']:.3f}", "KL": f"{last['approx_kl']:.2g}",
             "env-steps/s": f"{last['env_steps_per_s']:,.0f}",
             "ETA": _eta(finished, total, update, int(last["env_steps"]) / update, rate),
@@ -128,7 +148,7 @@ def _total_updates(metrics: pd.DataFrame, job: Job, finished: bool) -> int | Non
 
 
 def _eta(finished: bool, total: int | None, update: int, steps_per_update: float, rate: float) -> str:
-    """Time left at the recent speed (the updates' own time: checkpoints and logs add a little)."""
+    """Time left at the job's median speed (the updates' own time: checkpoints and logs add a little)."""
     if finished:
         return "-"
     if total is None or not rate > 0:
@@ -160,21 +180,63 @@ def table(run: Run, jobs: list[Job], metrics: dict[str, pd.DataFrame | None], no
     return f"{title}\n{rows.to_string(index=False)}"
 
 
-def plot_curves(metrics: dict[str, pd.DataFrame | None], path: Path) -> None:
-    """Return, entropy and KL against env steps, one line per job that has metrics, as a PNG (atomically, so an
-    image viewer open on it never reads half a file)."""
+def curve_columns(metrics: dict[str, pd.DataFrame | None]) -> list[str]:
+    """The metrics ``--plot`` draws: every numeric column any job has, except :data:`NOT_CURVES`, in the order the
+    jobs' tables have them."""
+    columns: dict[str, None] = {}
+    for df in metrics.values():
+        if df is not None:
+            columns.update((c, None) for c in df.select_dtypes("number").columns if c not in NOT_CURVES)
+    return list(columns)
+
+
+def task_groups(names: list[str]) -> dict[str, list[str]]:
+    """Jobs grouped by task, each group drawn on its own axes: the foraging seeds together, each policy recipe
+    (homing: another task, another reward scale) alone."""
+    seeds = [n for n in names if _job_order(n)[0] == 0]
+    return {**({"foraging seeds": seeds} if seeds else {}), **{n: [n] for n in names if n not in seeds}}
+
+
+def _steps(value: float, _position=None) -> str:
+    """An env-step tick label short enough not to overlap: 80k, 1.2M."""
+    for scale, suffix in ((1e6, "M"), (1e3, "k")):
+        if abs(value) >= scale:
+            return f"{value / scale:g}{suffix}"
+    return f"{value:g}"
+
+
+def plot_curves(metrics: dict[str, pd.DataFrame | None], path: Path, title: str = "") -> None:
+    """Every metric (:func:`curve_columns`) against env steps, one panel each and one colour per job, each task
+    (:func:`task_groups`) on its own rows of axes, under ``title``; a PNG written atomically, so an image viewer
+    open on it never reads half a file."""
+    from matplotlib.ticker import FuncFormatter
+
     from .figures.style import panel_style
 
+    columns = curve_columns(metrics) or ["episode_return"]
+    groups = task_groups([n for n, df in metrics.items() if df is not None]) or {"no job has metrics yet": []}
+    per_row = min(PANELS_PER_ROW, len(columns))
+    rows_per_group = math.ceil(len(columns) / per_row)
     with panel_style() as plt:
-        fig, axes = plt.subplots(1, len(CURVES), figsize=(11, 3.2), constrained_layout=True)
-        for ax, (column, label) in zip(axes, CURVES.items(), strict=True):
-            for name, df in metrics.items():
-                if df is not None and column in df.columns:
-                    points = df[["env_steps", column]].dropna()
-                    ax.plot(points["env_steps"], points[column], marker=".", markersize=3, lw=1, label=name)
-            ax.set(xlabel="env steps", ylabel=label)
-        if any(ax.lines for ax in axes):
-            axes[0].legend(fontsize=6)
+        fig, axes = plt.subplots(rows_per_group * len(groups), per_row, squeeze=False, constrained_layout=True,
+                                 figsize=(2.6 * per_row, 2.2 * rows_per_group * len(groups)))
+        colours = {name: f"C{i % 10}" for i, name in enumerate(metrics)}
+        for g, (group, names) in enumerate(groups.items()):
+            block = axes[g * rows_per_group:(g + 1) * rows_per_group].ravel()
+            for ax, column in zip(block, columns, strict=False):
+                for name in names:
+                    df = metrics[name]
+                    if column in df.columns:
+                        points = df[["env_steps", column]].dropna()
+                        ax.plot(points["env_steps"], points[column], lw=1, color=colours[name], label=name)
+                ax.set_title(f"{group}: {CURVE_LABELS.get(column, column)}", fontsize=7)
+                ax.set_xlabel("env steps")
+                ax.xaxis.set_major_formatter(FuncFormatter(_steps))
+            for ax in block[len(columns):]:
+                ax.axis("off")
+            if any(ax.lines for ax in block):
+                block[0].legend(fontsize=6)
+        fig.suptitle(title or "training curves", fontsize=9)
         with atomic_path(path) as tmp:
             fig.savefig(tmp, format="png", dpi=120)
         plt.close(fig)
@@ -194,7 +256,7 @@ def watch(run: Run, interval: float = 10.0, once: bool = False, plot: Path | Non
         jobs = training_jobs(run)
         metrics = {job.name: read_metrics(job) for job in jobs}
         if plot is not None:
-            plot_curves(metrics, plot)
+            plot_curves(metrics, plot, f"{run.name}: training curves ({time.strftime('%Y-%m-%d %H:%M:%S')})")
         show(clear + table(run, jobs, metrics, time.time()))
         if once or all((job.folder / FINAL_POLICY).exists() for job in jobs):
             return
