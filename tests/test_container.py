@@ -33,7 +33,9 @@ CPU_INDEX = "https://download.pytorch.org/whl/cpu"
 RECIPES = {"dockerfile": "Dockerfile", "dockerignore": ".dockerignore", "definition": "container/efish.def",
            "install": "container/install.sh",
            "pyproject": "pyproject.toml", "environment": "environment.yml", "readme": "README.md",
-           "snakefile": "Snakefile", "docs": "docs/getting-started.md"}
+           "snakefile": "Snakefile", "docs": "docs/getting-started.md", "lock": "container/requirements.lock"}
+#: The extras the image installs beyond the README's: tensorboard, so that train.loggers=[csv,tensorboard] works in it.
+IMAGE_EXTRAS = {"tensorboard"}
 
 
 # ------------------------------------------------------------------ parsers
@@ -159,7 +161,8 @@ def build_inputs(pyproject: str) -> set[str]:
     data = tomllib.loads(pyproject)
     wheel = data["tool"]["hatch"]["build"]["targets"]["wheel"]
     paths = [data["project"]["readme"], *wheel["packages"], *wheel.get("force-include", {})]
-    return {"pyproject.toml", "container/install.sh", *(path.split("/")[0] for path in paths)}
+    return {"pyproject.toml", "container/install.sh", "container/requirements.lock",
+            *(path.split("/")[0] for path in paths)}
 
 
 def environment_python(environment: str) -> str:
@@ -221,8 +224,8 @@ def copy_problems(texts: dict[str, str]) -> list[str]:
 
 
 def pin_problems(texts: dict[str, str]) -> list[str]:
-    """install.sh installs pyproject's torch pin from the CPU index, the checkout with the README's extras, and
-    restates no other version."""
+    """install.sh installs pyproject's torch pin from the CPU index, the checkout with the README's extras and
+    :data:`IMAGE_EXTRAS`, and restates no other version."""
     installs, found = pip_installs(texts["install"]), []
     torch, pin = [w for words in installs for w in words if w.startswith("torch")], torch_pin(texts["pyproject"])
     if torch != [f"torch=={pin}"]:
@@ -234,9 +237,64 @@ def pin_problems(texts: dict[str, str]) -> list[str]:
     if restated:
         found.append(f"install.sh restates pins pyproject owns: {restated}")
     package = [words[-1] for words in installs if words[-1].startswith("$1")]
-    wanted = extras(readme_install(texts["readme"]))
+    wanted = extras(readme_install(texts["readme"])) | IMAGE_EXTRAS
     if len(package) != 1 or extras(package[0].replace("$1", ".")) != wanted:
-        found.append(f"install.sh installs the checkout as {package}, the README with extras {sorted(wanted)}")
+        found.append(f"install.sh installs the checkout as {package}, not with extras {sorted(wanted)}")
+    return found
+
+
+def lock_pins(lock: str) -> dict[str, str]:
+    """The lock's ``NAME==VERSION`` lines as {normalised name: version}; ValueError for any other line."""
+    from packaging.utils import canonicalize_name
+
+    pins = {}
+    for line in lock.splitlines():
+        if line.strip() and not line.startswith("#"):
+            m = re.fullmatch(r"([A-Za-z0-9][\w.-]*)==([\w.!+-]+)", line.strip())
+            if not m:
+                raise ValueError(f"a lock line is not NAME==VERSION: {line!r}")
+            pins[canonicalize_name(m[1])] = m[2]
+    return pins
+
+
+def lock_python(lock: str) -> str | None:
+    """The Python the lock was resolved on, from its header (``on Python 3.11.7``)."""
+    m = re.search(r"on Python (\d+\.\d+\.\d+)", lock)
+    return m[1] if m else None
+
+
+def lock_problems(texts: dict[str, str]) -> list[str]:
+    """The lock satisfies every dependency pyproject declares for the image (its dependencies and
+    :data:`IMAGE_EXTRAS`), install.sh takes it as constraints, and both images build on the Python patch release
+    it was resolved on."""
+    import tomllib
+
+    from packaging.requirements import Requirement
+    from packaging.utils import canonicalize_name
+
+    found, pins = [], lock_pins(texts["lock"])
+    project = tomllib.loads(texts["pyproject"])["project"]
+    wanted = [*project["dependencies"], *(d for e in IMAGE_EXTRAS for d in project["optional-dependencies"][e])]
+    for spec in wanted:
+        req = Requirement(spec)
+        if req.marker is not None and not req.marker.evaluate():
+            continue
+        name = canonicalize_name(req.name)
+        if name not in pins:
+            found.append(f"the lock lacks {req.name} (pyproject: {spec}): run sh container/lock.sh")
+        elif not req.specifier.contains(pins[name], prereleases=True):
+            found.append(f"the lock's {req.name}=={pins[name]} does not satisfy pyproject's {spec}: run "
+                         "sh container/lock.sh")
+    constrained = [words for words in pip_installs(texts["install"])
+                   if any(w.startswith("$1") for w in words) and "-c" in words]
+    if not any(words[words.index("-c") + 1] == "$1/container/requirements.lock" for words in constrained):
+        found.append("install.sh does not install the checkout with -c container/requirements.lock")
+    python = lock_python(texts["lock"])
+    for name, image in (("Dockerfile", dockerfile(texts["dockerfile"])[0][1]),
+                        ("efish.def", definition(texts["definition"])[0]["from"])):
+        if python is None or not re.fullmatch(rf"(?:docker\.io/(?:library/)?)?python:{re.escape(python)}-[\w.-]+",
+                                              image):
+            found.append(f"{name} builds on {image}, not on the Python {python} the lock was resolved on")
     return found
 
 
@@ -259,8 +317,8 @@ def image_problems(texts: dict[str, str]) -> list[str]:
 
 def problems(texts: dict[str, str]) -> list[str]:
     """Every way the recipes in ``texts`` (keys of :data:`RECIPES`) differ from what the sources pin; none: agree."""
-    return [p for check in (python_problems, copy_problems, pin_problems, cuda_problems, image_problems)
-            for p in check(texts)]
+    return [p for check in (python_problems, copy_problems, pin_problems, lock_problems, cuda_problems,
+                            image_problems) for p in check(texts)]
 
 
 @pytest.fixture(scope="module")
@@ -271,21 +329,32 @@ def texts() -> dict[str, str]:
 def test_the_recipes_install_what_the_sources_pin(texts):
     assert problems(texts) == []
     assert extras(readme_install(texts["readme"])) == set()  # the README's first command: pip install -e .
+    assert lock_python(texts["lock"]) is not None and lock_python(texts["lock"]).startswith(
+        environment_python(texts["environment"]) + ".")
     assert python_of_image(dockerfile(texts["dockerfile"])[0][1]) == "3.11" == environment_python(texts["environment"])
 
 
 @pytest.mark.parametrize("key, old, new, expected", [
     ("install", "TORCH=2.13.0", "TORCH=2.12.0", "install.sh installs ['torch==2.12.0'], pyproject pins torch==2.13.0"),
     ("pyproject", '"torch==2.13.0"', '"torch==2.14.0"', "pyproject pins torch==2.14.0"),
-    ("dockerfile", "FROM python:3.11-slim", "FROM python:3.12-slim", "Dockerfile builds on Python 3.12"),
+    ("dockerfile", "FROM python:3.11.7-slim-bookworm", "FROM python:3.12-slim", "Dockerfile builds on Python 3.12"),
+    ("dockerfile", "FROM python:3.11.7-slim-bookworm", "FROM python:3.11-slim",
+     "Dockerfile builds on python:3.11-slim, not on the Python 3.11.7 the lock was resolved on"),
+    ("lock", "\nnumba==", "\n# numba==", "the lock lacks numba"),
+    ("lock", "\ntorch==2.13.0", "\ntorch==2.12.0", "the lock's torch==2.12.0 does not satisfy pyproject's torch==2.13.0"),
+    ("install", '-c "$SOURCE/container/requirements.lock" ', "", "does not install the checkout with -c"),
+    ("install", '"$SOURCE[tensorboard]"', '"$SOURCE"', "installs the checkout as ['$1'], not with extras ['tensorboard']"),
+    ("dockerignore", "!container/requirements.lock\n", "",
+     ".dockerignore leaves out what the Dockerfile copies: ['container/requirements.lock']"),
     ("environment", "python=3.11", "python=3.12", "efish.def builds on Python 3.11, environment.yml has 3.12"),
-    ("install", '"$SOURCE"', '"$SOURCE[slurm]"', "installs the checkout as ['$1[slurm]']"),
+    ("install", '"$SOURCE[tensorboard]"', '"$SOURCE[slurm]"', "installs the checkout as ['$1[slurm]']"),
     ("install", "CPU_INDEX=https://download.pytorch.org/whl/cpu", "CPU_INDEX=https://download.pytorch.org/whl/cu128",
      "torch is not installed from the CPU index only"),
-    ("install", '"$SOURCE"', '"$SOURCE" "numpy==2.0"', "install.sh restates pins pyproject owns: ['numpy==2.0']"),
-    ("dockerfile", "FROM python:3.11-slim", "FROM nvidia/cuda:12.8.0-runtime-ubuntu24.04",
+    ("install", '"$SOURCE[tensorboard]"', '"$SOURCE[tensorboard]" "numpy==2.0"',
+     "install.sh restates pins pyproject owns: ['numpy==2.0']"),
+    ("dockerfile", "FROM python:3.11.7-slim-bookworm", "FROM nvidia/cuda:12.8.0-runtime-ubuntu24.04",
      "the recipes name CUDA: ['cuda', 'nvidia']"),
-    ("definition", "From: python:3.11-slim", "From: ubuntu:24.04", "efish.def builds on ubuntu:24.04, not on an"),
+    ("definition", "From: python:3.11.7-slim-bookworm", "From: ubuntu:24.04", "efish.def builds on ubuntu:24.04, not on an"),
     ("definition", "    src /opt/efish-src/src\n", "", "the Dockerfile copies"),
     ("dockerignore", "!config\n", "", ".dockerignore leaves out what the Dockerfile copies: ['config']"),
     ("pyproject", '"config" = "efish/_config"', '"config" = "efish/_config"\n"workflow" = "efish/_workflow"',
