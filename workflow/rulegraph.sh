@@ -3,10 +3,10 @@
 #   workflow/rulegraph.sh [OUT.svg]          (default docs/img/rulegraph.svg; needs graphviz's dot)
 # It draws `snakemake --rulegraph` of the laptop scale, planned in an empty folder so that no earlier run's
 # outputs change the graph: one box per rule, an arrow where a rule's output is another's input, left to right
-# (rankdir=LR: the page is narrower than the graph is wide). The rules that
-# wait on the select_seed checkpoint's choice (top_seed_assay, top_seed_analysis_<name>, top_seed_claims) are
-# planned only once it has run, so they are not drawn. tests/workflow/test_rulegraph.py checks that the
-# committed picture names the workflow's rules.
+# (rankdir=LR: the page is narrower than the graph is wide). The rules that wait on the select_seed checkpoint's
+# choice (top_seed_group, top_seed_assay, top_seed_analysis_<name>, top_seed_claims) are planned only once it has
+# run, so they are not drawn. tests/workflow/test_rulegraph.py checks that the committed picture names the
+# workflow's rules.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-docs/img/rulegraph.svg}

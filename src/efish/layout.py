@@ -12,6 +12,7 @@ its tables under ``results/<run>/`` and its drawings under ``figures/<run>/``::
       analysis/<analysis>/<assay>/    the tables of efish.analysis.registry, analysis_settings.parquet
       seeds/<assay>/episodes.parquet  the top seeds' episodes stacked (supplement)
       seeds/seed_N/                   another top seed's assays, analyses and claims, same layout
+      seeds/groups/<assay>/seed_N/    while a run lasts: the top seeds' reruns of an assay, rolled out in one job
       learning/stage_K/               the same for the selected seed's K-th kept training stage
       learning/                       claims_by_stage, claims_trends .parquet, claims.md (claims along training)
       scenes/<scene>.parquet          field maps
@@ -151,6 +152,13 @@ def parse_table(path: str) -> TableId | None:
 def top_seed_copy(seed: int | str) -> str:
     """``seeds/seed_N``: another top seed's copy of the layout (its assays, analyses and claims)."""
     return f"seeds/{seed_name(seed)}"
+
+
+def top_seed_group(assay: str) -> str:
+    """``seeds/groups/<assay>``: where one job rolls out every top seed that reruns ``assay`` (``efish assay
+    --group``), one :func:`seed_name` folder each, before each seed's tables are handed to its copy of the layout.
+    The workflow removes it once every seed has its tables (a Snakemake ``temp`` output)."""
+    return f"seeds/groups/{assay}"
 
 
 def stage_copy(k: int | str) -> str:

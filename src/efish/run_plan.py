@@ -282,7 +282,9 @@ class RunPlan:
         policies = checked_policies(scale, overrides, assays, asked, recipes, cache)
         for name in [*asked, *cfg.scale.top_seed_assays]:
             settings.setdefault(name, composed([*base, f"assay={name}"]).assay)
-        return cls(scale, overrides, run, cfg, assays, asked, recipes, settings, policies)
+        plan = cls(scale, overrides, run, cfg, assays, asked, recipes, settings, policies)
+        plan.check_groups()
+        return plan
 
     # -------------------------------------------------------------- the run
     @property
@@ -388,6 +390,28 @@ class RunPlan:
     def top_seed_assays(self) -> list[str]:
         """Every assay a top seed may run in its copy of the layout: the claims' and ``scale.top_seed_assays``."""
         return sorted({*self.seed_claim_assays, *self.cfg.scale.top_seed_assays})
+
+    def group_seeds(self, assay: str, top: Sequence[int]) -> list[int]:
+        """The top seeds (``top``, best first: the selected seed, then the others) that rerun ``assay``, all in one
+        job (``efish assay --group``): every top seed for ``scale.top_seed_assays`` (the supplement's panels), the
+        others for a claim's assay (their own claims)."""
+        if assay in self.cfg.scale.top_seed_assays:
+            return list(top)
+        return list(top[1:]) if assay in self.seed_claim_assays else []
+
+    def check_groups(self) -> None:
+        """A :class:`PlanError` for an assay the top seeds rerun that cannot run as a group: in a group each seed
+        acts as the assay's own policy (``assay.policy``), and deterministically (sampled actions would share one
+        random stream, :func:`efish.rollout.group.run_group`)."""
+        for name in self.top_seed_assays if self.cfg.scale.top_seeds else []:
+            assay = self.assay_settings[name]
+            if assay.policy != SELECTED:
+                raise PlanError(f"assay {name}: the top seeds rerun it with each seed as its own policy, but its "
+                                f"assay.policy is {assay.policy!r}: set assay.policy={SELECTED} (a condition may "
+                                f"still name a recipe) or leave it out of scale.top_seed_assays")
+            if not assay.deterministic:
+                raise PlanError(f"assay {name}: the top seeds rerun it as one group, which needs "
+                                f"assay.deterministic=true")
 
     # -------------------------------------------------------------- figures
     @functools.cached_property

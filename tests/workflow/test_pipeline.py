@@ -19,9 +19,10 @@ from efish.analysis.selection import RANKING_COLUMNS
 from efish.bench.accuracy import COLUMNS
 from efish.claims.recipe import RECIPE_PART_COLUMNS
 from efish.config import run_name
+from efish.layout import Run, top_seed_group
 from efish.rollout.schema import SCHEMAS, check_file
 
-from ..helpers import smoke_env
+from ..helpers import scratch_workflow, smoke_env
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -44,7 +45,10 @@ def test_every_declared_output_exists(smoke_run):
                  "analysis/homing/homing/perception.parquet"):
         assert f"results/smoke/{part}" in outputs, part
     assert any(o.startswith("figures/smoke/fig3/") for o in outputs)
-    missing = [o for o in outputs if not (smoke_run / o).is_file()]
+    # the top seeds' group folders are temp outputs: gone once every seed has its tables
+    groups = [o for o in outputs if o.startswith(f"{Run('smoke').path(top_seed_group(''))}/")]
+    assert groups and not any((smoke_run / o).exists() for o in groups)
+    missing = [o for o in outputs if o not in groups and not (smoke_run / o).is_file()]
     assert not missing
 
 
@@ -159,39 +163,51 @@ def test_one_job_draws_each_figure(tmp_path):
     assert drawing == {**{f"figure_{page}": 1 for page in pages}, "contact_sheet": 1}
 
 
-#: The claims' verdicts, and how seeds_agree counts them ("2/2 hold", "1/2 hold, 1/2 weaker (seed 1: ...)").
-VERDICTS = {"holds", "weaker", "fails", "not decidable", "not run"}
-COUNT = r"\d+/\d+ (hold|weaker|fail|not decidable)"
+#: The claims' verdicts, and how seeds_agree counts them ("2/2 hold", "1/2 hold, 1/2 absent (seed 1: ...)").
+VERDICTS = {"holds", "absent", "opposite", "inconclusive", "not decidable", "not run"}
+COUNT = r"\d+/\d+ (hold|absent|opposite|inconclusive|not decidable)"
 SEEDS_AGREE = re.compile(rf"not run \(0/\d+ seeds ran\)|{COUNT}(, {COUNT})*"
                          r"( \((other seeds|seeds? [\d, ]+): not run\))?")
+
+
+def selected(work: Path, seeds: list[int], ranking: list[int], run: str) -> None:
+    """The select_seed checkpoint done in ``work``'s results/<run>: every seed trained and evaluated (empty files, in
+    time order) and ranked ``ranking``, the first selected."""
+    folder = work / "results" / run
+    old, older = time.time() - 3600, time.time() - 7200
+    for seed in seeds:
+        for path, when in ((f"train/seed_{seed}/final.pt", older), (f"train/seed_{seed}/metrics.parquet", older),
+                           *((f"selection/seed_{seed}/{t}.parquet", old) for t in ("episodes", "steps", "food", "conditions"))):
+            (folder / path).parent.mkdir(parents=True, exist_ok=True)
+            (folder / path).touch()
+            os.utime(folder / path, (when, when))
+    (folder / "analysis/selection").mkdir(parents=True)
+    pd.DataFrame({"seed": ranking}).to_parquet(folder / "analysis/selection/ranking.parquet")
+    (folder / "analysis/selection/selected_seed.txt").write_text(f"{ranking[0]}\n")
 
 
 def test_the_other_top_seeds_rerun_the_claims_assays_for_their_own_claims(tmp_path):
     """With the select_seed checkpoint done (seed 2 chosen, seed 1 next), the smoke DAG with top_seeds 2 reruns every
     claim's assay that acts with the selected policy for seed 1, never homing (recipe policies), never the selected
-    seed's, and the claims job combines seed 1's claims table with the selected seed's."""
+    seed's, and the claims job combines seed 1's claims table with the selected seed's. The supplement's assays run
+    both seeds in one job (efish assay --group); each seed's tables reach its copy of the layout by hard links."""
     # the smoke scale ships top_seeds 1 (CI time); run=smoke keeps the folder name with the override
-    run = tmp_path / "results/smoke"
-    old, older = time.time() - 3600, time.time() - 7200
-    for seed in (1, 2):
-        for path, when in ((f"train/seed_{seed}/final.pt", older), (f"train/seed_{seed}/metrics.parquet", older),
-                           *((f"selection/seed_{seed}/{t}.parquet", old) for t in ("episodes", "steps", "food", "conditions"))):
-            (run / path).parent.mkdir(parents=True, exist_ok=True)
-            (run / path).touch()
-            os.utime(run / path, (when, when))
-    (run / "analysis/selection").mkdir(parents=True)
-    pd.DataFrame({"seed": [2, 1]}).to_parquet(run / "analysis/selection/ranking.parquet")
-    (run / "analysis/selection/selected_seed.txt").write_text("2\n")
+    selected(tmp_path, [1, 2], [2, 1], "smoke")
     result = dry_run(tmp_path, "--config", "scale=smoke", "run=smoke", "overrides=scale.top_seeds=2",
                      "--rerun-triggers", "mtime", "--printshellcmds")
     assert result.returncode == 0, result.stderr[-2000:]
     out = result.stdout
-    assert ("efish assay scale=smoke scale.top_seeds=2 assay=uniform4 --policy selected=results/smoke/train/seed_1/final.pt "
-            "--out results/smoke/seeds/seed_1/assays/uniform4") in out
+    assert ("efish assay scale=smoke scale.top_seeds=2 assay=uniform4 --group 1=results/smoke/train/seed_1/final.pt "
+            "--out 'results/smoke/seeds/groups/uniform4/seed_{member}'") in out
+    assert ("efish assay scale=smoke scale.top_seeds=2 assay=patchy4 --group 2=results/smoke/train/seed_2/final.pt "
+            "1=results/smoke/train/seed_1/final.pt --out 'results/smoke/seeds/groups/patchy4/seed_{member}'") in out
+    assert ("ln -fv results/smoke/seeds/groups/uniform4/seed_1/* results/smoke/seeds/seed_1/assays/uniform4 "
+            in out)
     assert "results/smoke/seeds/seed_1/assays/wide2/hidden.parquet" in out  # record_hidden: dynamics reads it
     assert ("--tables results/smoke/seeds/seed_1/assays/wide2 --out results/smoke/seeds/seed_1/analysis/dynamics/wide2"
             in out)
     assert "seeds/seed_1/assays/homing" not in out and "seeds/seed_2/assays/uniform4" not in out
+    assert "seeds/groups/homing" not in out
     assert "seeds/seed_2/claims" not in out  # the selected seed's claims are the run's own
     assert ("efish claims scale=smoke scale.top_seeds=2 --results results/smoke/seeds/seed_1 --out "
             "results/smoke/seeds/seed_1/claims" in out)
@@ -199,6 +215,59 @@ def test_the_other_top_seeds_rerun_the_claims_assays_for_their_own_claims(tmp_pa
     assert ("efish claims scale=smoke scale.top_seeds=2 --results results/smoke --out results/smoke/claims --ranking "
             "results/smoke/analysis/selection/ranking.parquet --seed-claims "
             "1=results/smoke/seeds/seed_1/claims/claims.parquet") in out
+
+
+def test_one_job_rolls_out_every_top_seed_that_reruns_an_assay(tmp_path):
+    """The laptop scale's 4 top seeds rerun 12 assays: the 9 claim assays that are not the supplement's, each by the
+    3 other seeds, and the supplement's 3, each by all 4 (39 table sets). Each assay's reruns are one efish call
+    (top_seed_group: 12 calls, each paying the start-up once, where there were 39 jobs); each seed's tables reach its
+    copy of the layout by one job that starts no Python (top_seed_assay*: 39 hard links; a local rule, which a
+    cluster does not queue)."""
+    from efish.config import compose
+
+    selected(tmp_path, compose(["scale=laptop"]).scale.seed_numbers(), [3, 1, 4, 2], "laptop")
+    result = dry_run(tmp_path, "--config", "scale=laptop", "--rerun-triggers", "mtime", "--printshellcmds")
+    assert result.returncode == 0, result.stderr[-2000:]
+    jobs = job_counts(result.stdout)
+    assert jobs["top_seed_group"] == 12 and jobs["top_seed_assay"] + jobs["top_seed_assay_with_hidden"] == 39
+    calls = [line for line in result.stdout.splitlines() if line.startswith("Shell command: efish assay")
+             and "/seeds/" in line]
+    assert len(calls) == 12 and all(" --group 3=" in call or " --group 1=" in call for call in calls)
+    assert len(re.findall(r"^Shell command: \(ln -fv results/laptop/seeds/groups/", result.stdout, flags=re.M)) == 39
+
+
+@pytest.mark.slow
+def test_a_grouped_rerun_gives_each_seed_the_tables_of_its_run_alone(smoke_run, tmp_path):
+    """Both smoke seeds as top seeds: one job rolls out both in patchy4 and in wide2 (which records hidden states),
+    and each seed's tables in its copy of the layout are, byte for byte, those of efish assay run with that seed
+    alone; the group's folder is gone once every seed has its tables."""
+    work = scratch_workflow(tmp_path / "grouped")
+    for part in ("train", "selection", "analysis/selection"):  # the checkpoint done, in time order (copy2: mtimes)
+        shutil.copytree(smoke_run / "results/smoke" / part, work / "results/smoke" / part)
+    overrides = ["scale=smoke", "scale.top_seeds=2"]
+    tables = {"patchy4": ["steps", "episodes", "food", "conditions"], "wide2": ["steps", "hidden"]}
+    targets = [f"results/smoke/seeds/seed_{seed}/assays/{assay}/{t}.parquet" for seed in (1, 2)
+               for assay, names in tables.items() for t in names]
+    result = subprocess.run(["snakemake", "--cores", "1", "--config", "scale=smoke", "run=smoke",
+                             f"overrides={overrides[1]}", "--rerun-triggers", "mtime", "--directory", str(work),
+                             "--snakefile", str(work / "Snakefile"), *targets],
+                            capture_output=True, text=True, timeout=900, env=smoke_env(work))
+    assert result.returncode == 0, result.stderr[-3000:]
+    assert re.findall(r"^(?:local)?rule (\w+):", result.stderr, flags=re.M).count("top_seed_group") == 2
+    assert not (work / "results/smoke/seeds/groups/patchy4").exists()  # temp: removed once both seeds have theirs
+    for seed in (1, 2):
+        for assay, names in tables.items():
+            alone = tmp_path / f"alone_{seed}_{assay}"
+            solo = subprocess.run(["efish", "assay", *overrides, f"assay={assay}", "--policy",
+                                   f"selected={work}/results/smoke/train/seed_{seed}/final.pt", "--out", str(alone)],
+                                  capture_output=True, text=True, timeout=300, env=smoke_env(work))
+            assert solo.returncode == 0, solo.stderr[-2000:]
+            grouped = work / f"results/smoke/seeds/seed_{seed}/assays/{assay}"
+            for name in [*names, "config"]:
+                suffix = ".yaml" if name == "config" else ".parquet"
+                assert (grouped / f"{name}{suffix}").read_bytes() == (alone / f"{name}{suffix}").read_bytes(), \
+                    (seed, assay, name)
+            assert "--group" in json.loads((grouped / "provenance.json").read_text())["command"]
 
 
 @pytest.mark.slow

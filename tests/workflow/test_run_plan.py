@@ -5,6 +5,7 @@ The DAG itself is checked by the dry runs of test_pipeline.py; here each piece o
 
 from __future__ import annotations
 
+import dataclasses
 import shutil
 from pathlib import Path
 
@@ -159,6 +160,35 @@ def test_a_rerun_runs_only_the_analyses_the_claims_read(plans):
         for assay in plan.seed_analysis_assays(analysis):
             assert any(t.startswith(f"analysis/{analysis.name}/{assay}/") for t in plan.seed_claim_tables)
     assert set(plan.seed_analysis_assays(ANALYSES["dynamics"])) <= set(plan.hidden_assays)  # it reads hidden
+
+
+@pytest.mark.parametrize("scale", SCALES)
+def test_each_assay_the_top_seeds_rerun_is_one_group_of_the_seeds_that_rerun_it(plans, scale):
+    """The supplement's assays: every top seed, the selected one first; a claim's assay: the other top seeds (the
+    selected seed's claims are the run's own); any other assay: none."""
+    plan, top = plans[scale], [3, 1, 2]
+    supplement = set(plan.cfg.scale.top_seed_assays)
+    for assay in plan.top_seed_assays:
+        assert plan.group_seeds(assay, top) == (top if assay in supplement else [1, 2]), assay
+    assert plan.group_seeds("homing", top) == [] and plan.group_seeds("patchy4", [3]) == [3]
+
+
+def test_an_assay_the_top_seeds_cannot_rerun_as_a_group_is_one_line(plans):
+    """Each seed of a group acts as the assay's own policy, deterministically (RunPlan.from_config checks)."""
+    plan = plans["smoke"]
+    scale, patchy4 = plan.cfg.scale, plan.assay_settings["patchy4"]
+    homing = dataclasses.replace(plan, cfg=dataclasses.replace(plan.cfg, scale=dataclasses.replace(
+        scale, top_seed_assays=["homing"])))
+    with pytest.raises(PlanError, match="^assay homing: the top seeds rerun it with each seed as its own policy, but "
+                                        "its assay.policy is 'homing': set assay.policy=selected"):
+        homing.check_groups()
+    sampled = dataclasses.replace(plan, assay_settings={**plan.assay_settings, "patchy4": dataclasses.replace(
+        patchy4, deterministic=False)})
+    with pytest.raises(PlanError, match="^assay patchy4: the top seeds rerun it as one group, which needs "
+                                        "assay.deterministic=true$"):
+        sampled.check_groups()
+    dataclasses.replace(homing, cfg=dataclasses.replace(homing.cfg, scale=dataclasses.replace(
+        homing.cfg.scale, top_seeds=0))).check_groups()  # no top seeds, no reruns
 
 
 def test_the_top_seeds_are_read_from_the_ranking_in_its_order(tmp_path):

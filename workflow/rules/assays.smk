@@ -32,24 +32,58 @@ use rule assay as assay_with_hidden with:
 
 
 # The best-ranked seeds (scale.top_seeds, from the select_seed checkpoint's ranking) rerun assays with their own
-# checkpoint as the `selected` policy, each in its own copy of the layout (efish.layout.Run.top_seed): every top
-# seed runs scale.top_seed_assays for the supplement's top-seed panels, and each top seed other than the selected
-# one also runs every claim's assay (efish.run_plan: RunPlan.seed_claim_assays) for its own claims table. They are
-# the selected seed's rules, whose inputs (assay_policies_input) read {seed}, at scale.top_seed_episodes episodes per
-# condition (more seeds at fewer episodes decide the recipe's verdict better: efish.claims.recipe).
-use rule assay as top_seed_assay with:
+# checkpoint as the `selected` policy, at scale.top_seed_episodes episodes per condition (more seeds at fewer episodes
+# decide the recipe's verdict better: efish.claims.recipe), each into its own copy of the layout
+# (efish.layout.Run.top_seed): every top seed runs scale.top_seed_assays for the supplement's top-seed panels, and
+# each top seed other than the selected one also runs every claim's assay (efish.run_plan: RunPlan.seed_claim_assays,
+# RunPlan.group_seeds) for its own claims table.
+#
+# All the seeds that rerun an assay roll out in one job and one env (efish assay --group,
+# docs/methods/assays.md#grouped-rollouts): one start-up instead of one per seed, each seed's tables those of its
+# run alone (efish.rollout.group). The job writes them into a temporary folder, one seed_<n>/ per seed
+# (efish.layout.top_seed_group), not into the seeds' copies: the seeds are known only once the checkpoint has run
+# while a rule's outputs are fixed patterns, and Snakemake removes a job's outputs before it runs.
+rule top_seed_group:
+    input:
+        unpack(group_policies_input),
     output:
-        **assay_outputs(hidden=False, copy=TOP_SEED),
+        temp(directory(results(top_seed_group("{assay}")))),
+    log:
+        log(top_seed_group("{assay}")),
+    benchmark:
+        benchmark(top_seed_group("{assay}"))
     params:
         overrides=TOP_SEED_ARGS,
-        out=folder_of("steps"),
-        policies=policy_args,
+        policies=group_args,
+        out=lambda wildcards, output: str(Path(output[0]) / seed_name("{member}")),
+    wildcard_constraints:
+        assay=any_of(across(lambda plan: plan.top_seed_assays)),
+    conda:
+        "../envs/efish.yaml"
+    shell:
+        efish("assay", "assay={wildcards.assay} {params.policies} --out '{params.out}'")
+
+
+# Each seed's tables from its group's folder into its copy of the layout, where every later rule and the user read
+# them: hard links (a copy where the file system has none), so a job costs no Python start-up and no copying; a
+# local rule, so a cluster does not queue it. No benchmark: there is nothing to time. Snakemake touches the links
+# once made, and so their group's files, but a directory output's time is that of its own flag file
+# (.snakemake_timestamp), so the group does not look newer than the seeds' tables it gave.
+rule top_seed_assay:
+    input:
+        group_of_seed,
+    output:
+        **assay_outputs(hidden=False, copy=TOP_SEED),
     log:
         log("assays/{assay}", TOP_SEED),
-    benchmark:
-        benchmark("assays/{assay}", TOP_SEED)
+    params:
+        tables=lambda wildcards, input: str(Path(input[0]) / seed_name(wildcards.seed)),
+        out=folder_of("steps"),
     wildcard_constraints:
         assay=any_of(across(lambda plan: plan.by_hidden(plan.top_seed_assays, hidden=False))),
+    localrule: True
+    shell:
+        "(ln -fv {params.tables}/* {params.out} || cp -fv {params.tables}/* {params.out}) > {log} 2>&1"
 
 
 use rule top_seed_assay as top_seed_assay_with_hidden with:

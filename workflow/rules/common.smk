@@ -29,6 +29,7 @@ from efish.layout import (
     stage_name,
     stage_file,
     top_seed_copy,
+    top_seed_group,
     training_file,
 )
 
@@ -153,8 +154,13 @@ def analysis_outputs(analysis, copy=None):
 
 
 # ------------------------------------------------------------------ inputs behind the select_seed checkpoint
+def recipe_policy(wildcards, name):
+    """The final checkpoint of policy ``name`` (a seed's folder or a recipe of config/policy/) in the job's run."""
+    return results(training_file(name, "final.pt"), run=Run(wildcards.run))
+
+
 def seed_policy(wildcards, seed):
-    return results(training_file(seed_name(seed), "final.pt"), run=Run(wildcards.run))
+    return recipe_policy(wildcards, seed_name(seed))
 
 
 def stage_policy(run, seed, k):
@@ -175,7 +181,7 @@ def assay_policies_input(wildcards):
 
     def path(name):
         if name != run_plan.SELECTED:
-            return results(training_file(name, "final.pt"), run=Run(wildcards.run))
+            return recipe_policy(wildcards, name)
         if stage is not None:
             return stage_policy(wildcards.run, selected_seed(wildcards), stage)
         return seed_policy(wildcards, selected_seed(wildcards) if seed is None else seed)
@@ -198,6 +204,35 @@ def other_top_seeds(wildcards):
     """The top seeds other than the selected one (the ranking's first row), best first: each reruns every claim's
     assay in its own copy of the layout for its own claims table."""
     return top_seeds(wildcards)[1:]
+
+
+def group_seeds(wildcards):
+    """The top seeds that rerun assay {assay}, best first, all in one job (efish.run_plan.RunPlan.group_seeds)."""
+    return plan_of(wildcards).group_seeds(wildcards.assay, top_seeds(wildcards))
+
+
+def group_policies_input(wildcards):
+    """The policies of assay {assay}'s group job: the final checkpoint of each seed in it (named seed_<n>) and of
+    every recipe its conditions act with (by name)."""
+    recipes = [name for name in plan_of(wildcards).policies_of(wildcards.assay) if name != run_plan.SELECTED]
+    return {name: recipe_policy(wildcards, name) for name in [*recipes, *map(seed_name, group_seeds(wildcards))]}
+
+
+def group_args(wildcards, input):
+    """efish assay's --policy NAME=PATH of the recipes (if any) and --group SEED=PATH of the seeds."""
+    seeds = {seed_name(seed): seed for seed in group_seeds(wildcards)}
+    recipes = [f"{name}={path}" for name, path in input.items() if name not in seeds]
+    return " ".join([*(["--policy", *recipes] if recipes else []), "--group",
+                     *(f"{seed}={input[name]}" for name, seed in seeds.items())])
+
+
+def group_of_seed(wildcards):
+    """The group folder of assay {assay} that holds seed {seed}'s tables. A seed that does not rerun the assay (a
+    table asked for by hand) is an error naming those that do, not a group job that leaves it out."""
+    if int(wildcards.seed) not in (seeds := group_seeds(wildcards)):
+        raise ValueError(f"seed {wildcards.seed} does not rerun assay {wildcards.assay}; the top seeds that do: "
+                         f"{', '.join(map(str, seeds)) or 'none'}")
+    return results(top_seed_group(wildcards.assay), run=Run(wildcards.run))
 
 
 def other_seed_claims(wildcards):
