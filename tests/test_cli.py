@@ -30,7 +30,8 @@ def claims_rows(verdicts: dict[str, str]) -> pd.DataFrame:
     n = len(verdicts)
     return pd.DataFrame({"claim": list(verdicts), "panel": ["3O"] * n, "statistic": ["Spearman rho"] * n,
                          "effect": [0.4] * n, "ci_low": [0.1] * n, "ci_high": [0.7] * n, "n": [8] * n,
-                         "p": [0.01] * n, "verdict": list(verdicts.values()), "reason": [""] * n}, columns=ROW_COLUMNS)
+                         "p": [0.01] * n, "verdict": list(verdicts.values()),
+                         "parts": [f"1 {v}" for v in verdicts.values()], "reason": [""] * n}, columns=ROW_COLUMNS)
 
 
 @pytest.fixture
@@ -48,7 +49,7 @@ def seed_run(tmp_path, monkeypatch):
     run = tmp_path / "results" / "myrun"
     (run / "analysis" / "selection").mkdir(parents=True)
     pd.DataFrame({"seed": [3, 1, 7, 2]}).to_parquet(run / "analysis" / "selection" / "ranking.parquet")
-    for seed, verdicts, effect in ((1, {"C1": "not run", "C9": "weaker"}, 0.2), (7, {"C1": "not run", "C9": "holds"},
+    for seed, verdicts, effect in ((1, {"C1": "not run", "C9": "inconclusive"}, 0.2), (7, {"C1": "not run", "C9": "holds"},
                                                                                  0.5)):
         folder = run / "seeds" / f"seed_{seed}" / "claims"
         folder.mkdir(parents=True)
@@ -59,10 +60,11 @@ def seed_run(tmp_path, monkeypatch):
 
 
 def parts_rows(table: pd.DataFrame) -> pd.DataFrame:
-    """A parts table (PART_COLUMNS) with one part per claim of a claims table (CLI tests)."""
+    """A parts table (PART_COLUMNS) with one part per claim of a claims table (CLI tests), decided against a delta
+    of 0.2."""
     parts = table.rename(columns={"panel": "part"}).assign(sign=1.0, decides=True, ci_method="", family=1,
-                                                           p_floor=0.0, margin=float("nan"),
-                                                           margin_ratio=float("nan"))
+                                                           p_floor=0.0, reference=float("nan"), delta=0.2,
+                                                           p_opposite=1.0)
     return parts[PART_COLUMNS]
 
 
@@ -76,24 +78,28 @@ def test_efish_claims_adds_the_verdicts_of_the_other_top_seeds(seed_run, capsys)
                  "--ranking", str(seed_run / "analysis/selection/ranking.parquet"),
                  "--seed-claims", seed_table(seed_run, 7), seed_table(seed_run, 1)]) == 0
     table = pd.read_parquet(out / "claims.parquet").set_index("claim")
-    assert list(table.reset_index().columns) == [*ROW_COLUMNS[:2], *RECIPE_COLUMNS, *ROW_COLUMNS[2:9], "seed_verdicts",
-                                                 "seeds_agree", "reason"]
-    # the recipe: C9's effects 0.4 (seed 3), 0.2 and 0.5 over three seeds (t = 4.2, 2 df, p = 0.053)
+    assert list(table.reset_index().columns) == [*ROW_COLUMNS[:2], *RECIPE_COLUMNS, *ROW_COLUMNS[2:-1],
+                                                 "seed_verdicts", "seeds_agree", "reason"]
+    # the recipe: C9's effects 0.4 (seed 3), 0.2 and 0.5 over three seeds (t = 4.2, 2 df, p = 0.053); the 0.9 t
+    # interval [0.11, 0.62] straddles delta 0.2
     assert table.loc["C9", "recipe_seeds"] == 3 and table.loc["C9", "recipe_effect"] == pytest.approx(1.1 / 3)
-    assert table.loc["C9", "recipe_verdict"] == "weaker" and table.loc["C9", "recipe_p"] == pytest.approx(0.053, abs=1e-3)
+    assert table.loc["C9", "recipe_verdict"] == "inconclusive"
+    assert table.loc["C9", "recipe_p"] == pytest.approx(0.053, abs=1e-3)
+    assert table.loc["C9", "recipe_ci_low"] == pytest.approx(0.109, abs=1e-3)
     # C1 ran at the selected seed alone (as the homing claims do): one draw, said so
     assert table.loc["C1", "recipe_verdict"] == "holds" and table.loc["C1", "recipe_seeds"] == 1
     assert "one draw" in table.loc["C1", "recipe_reason"]
     recipe = pd.read_parquet(out / "recipe_parts.parquet")
     assert list(recipe.columns) == RECIPE_PART_COLUMNS and recipe["seeds"].tolist() == ["3", "3, 1, 7"]
-    assert table.loc["C9", "seed_verdicts"] == "seed 3: holds; seed 1: weaker; seed 7: holds"  # ranking order
-    assert table.loc["C9", "seeds_agree"] == "2/3 hold, 1/3 weaker"
+    assert table.loc["C9", "seed_verdicts"] == "seed 3: holds; seed 1: inconclusive; seed 7: holds"  # ranking order
+    assert table.loc["C9", "seeds_agree"] == "2/3 hold, 1/3 inconclusive"
     assert "flips between seeds" in table.loc["C9", "reason"]
     assert table.loc["C1", "seeds_agree"] == "1/1 hold (other seeds: not run)"
     page = (out / "claims.md").read_text()
-    assert "| selected seed's verdict | seeds_agree | reason | recipe reason |" in page
-    assert "| holds | 2/3 hold, 1/3 weaker |" in page and "| C9 | 3O | weaker | 0.367 [" in page
-    assert "The recipe (its top seeds together): 1 holds, 1 weaker. The selected seed: 2 holds." in page
+    assert "| selected seed's verdict | selected seed's parts | seeds_agree | reason | recipe reason |" in page
+    assert "| holds | 1 holds | 2/3 hold, 1/3 inconclusive |" in page
+    assert "| C9 | 3O | inconclusive | 1 inconclusive | 0.367 [" in page
+    assert "The recipe (its top seeds together): 1 holds, 1 inconclusive. The selected seed: 2 holds." in page
     assert "selected seed 3, other top seeds 1, 7" in page.splitlines()[0]
     assert "seeds_agree" in capsys.readouterr().out
 
@@ -101,7 +107,7 @@ def test_efish_claims_adds_the_verdicts_of_the_other_top_seeds(seed_run, capsys)
 def test_efish_claims_reads_the_runs_ranking_by_default_and_alone_gives_the_selected_seed(seed_run):
     assert main(["claims", "scale=smoke", "--results", str(seed_run), "--seed-claims", seed_table(seed_run, 1)]) == 0
     table = pd.read_parquet(seed_run / "claims" / "claims.parquet").set_index("claim")
-    assert table.loc["C9", "seed_verdicts"] == "seed 3: holds; seed 1: weaker"
+    assert table.loc["C9", "seed_verdicts"] == "seed 3: holds; seed 1: inconclusive"
     assert main(["claims", "scale=smoke", "--results", str(seed_run), "--seed-claims"]) == 0  # no other seed
     assert pd.read_parquet(seed_run / "claims" / "claims.parquet")["seeds_agree"].tolist() == ["1/1 hold"] * 2
 
@@ -185,7 +191,7 @@ def test_efish_claims_by_stage_reads_env_steps_from_the_stage_files_and_writes_t
         torch.save({"stage": {"k": k, "fraction": k / 4, "update": k, "env_steps": n, "total_updates": 4}},
                    tmp_path / f"stage_{k}.pt")
         policies.append(f"{k}={tmp_path / f'stage_{k}.pt'}")
-    claims_rows({"C3": "weaker", "C9": "holds"}).to_parquet(tmp_path / "claims.parquet")
+    claims_rows({"C3": "inconclusive", "C9": "holds"}).to_parquet(tmp_path / "claims.parquet")
     out = tmp_path / "learning"
     assert main(["claims-by-stage", "scale=smoke", *args[:args.index("--env-steps")], "--stage-policies", *policies,
                  "--claims", str(tmp_path / "claims.parquet"), "--out", str(out),
@@ -222,7 +228,7 @@ def test_compare_claims_shows_each_runs_seeds_agree_and_a_dash_without(tmp_path,
     (tmp_path / "new").mkdir()
     (tmp_path / "old").mkdir()
     with_seeds.to_parquet(tmp_path / "new" / "claims.parquet")
-    claims_rows({"C9": "weaker"}).to_parquet(tmp_path / "old" / "claims.parquet")
+    claims_rows({"C9": "inconclusive"}).to_parquet(tmp_path / "old" / "claims.parquet")
     assert main(["compare-claims", str(tmp_path / "new"), str(tmp_path / "old")]) == 0
     header, row, agreement = capsys.readouterr().out.splitlines()
     assert "new seeds_agree" in header and "old seeds_agree" in header
@@ -232,19 +238,19 @@ def test_compare_claims_shows_each_runs_seeds_agree_and_a_dash_without(tmp_path,
 
 def test_compare_claims_counts_the_recipe_verdicts_that_agree_between_two_runs(tmp_path, capsys):
     """The stability run's numbers: with the recipe's verdict in both tables, moved marks the recipe's and two
-    lines count the agreement of the recipe's and of the selected seeds' verdicts, naming holds-fails flips."""
-    rows = claims_rows({"C1": "holds", "C2": "weaker", "C3": "fails"})
-    a = rows.assign(recipe_verdict=["holds", "weaker", "holds"])
-    b = rows.assign(recipe_verdict=["holds", "fails", "fails"], verdict=["holds", "weaker", "holds"])
+    lines count the agreement of the recipe's and of the selected seeds' verdicts, naming holds-opposite flips."""
+    rows = claims_rows({"C1": "holds", "C2": "inconclusive", "C3": "opposite"})
+    a = rows.assign(recipe_verdict=["holds", "inconclusive", "holds"])
+    b = rows.assign(recipe_verdict=["holds", "opposite", "opposite"], verdict=["holds", "inconclusive", "holds"])
     for name, t in (("a", a), ("b", b)):
         (tmp_path / name).mkdir()
         t.to_parquet(tmp_path / name / "claims.parquet")
     assert main(["compare-claims", str(tmp_path / "a"), str(tmp_path / "b")]) == 0
     *table, recipe, selected = capsys.readouterr().out.splitlines()
     assert "a recipe" in table[0] and [line.rstrip().endswith("*") for line in table[1:]] == [False, True, True]
-    assert recipe == "recipe verdicts: the same for 1 of 3 claims; holds in one and fails in the other: C3 (a vs b)"
-    assert selected == ("selected seeds' verdicts: the same for 2 of 3 claims; holds in one and fails in the other: C3 "
-                        "(a vs b)")
+    assert recipe == "recipe verdicts: the same for 1 of 3 claims; holds in one and opposite in the other: C3 (a vs b)"
+    assert selected == ("selected seeds' verdicts: the same for 2 of 3 claims; holds in one and opposite in the other: "
+                        "C3 (a vs b)")
 
 
 # ------------------------------------------------- dispatch: every (sub)command has a handler

@@ -299,7 +299,7 @@ def _figure_commands(sub: argparse._SubParsersAction) -> None:
 def _claims_commands(sub: argparse._SubParsersAction) -> None:
     """The paper's claims as verdicts, along training and across runs: claims, claims-by-stage, compare-claims."""
     cl = add_command(sub, "claims", "the paper's claims as verdicts from a run's tables",
-                     "Test the paper's claims on a run's result tables under the nine rules and give each a verdict. "
+                     "Test the paper's claims on a run's result tables under the ten rules and give each a verdict. "
                      "Writes claims.parquet, claim_parts.parquet (a row per part) and claims.md to --out; with the "
                      "other top seeds' claims also seed_verdicts and seeds_agree.", "docs/claims/index.md",
                      "docs/claims/results.md")

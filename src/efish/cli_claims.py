@@ -44,7 +44,7 @@ def run_claims(args, cfg, started) -> None:
         selected, others, other_parts = seeds
         table = with_seed_verdicts(table, others, selected)
         recipe = recipe_parts({selected: parts, **other_parts}, selected, cfg.analysis.claims_alpha)
-        table = with_recipe_verdicts(table, recipe)
+        table = with_recipe_verdicts(table, recipe, cfg.analysis.claims_alpha)
         written[Path(RECIPE_PARTS).stem] = recipe
         header += f"; selected seed {selected}" + (f", other top seeds {', '.join(map(str, others))}" if others else "")
     table_path, page_path = out / Path(CLAIMS_TABLE).name, out / Path(CLAIMS_PAGE).name
@@ -148,7 +148,7 @@ def run_claims_by_stage(args, cfg, started) -> None:
     episodes = _stage_counts(args.episodes, "--episodes")
     final = read_parquet(args.claims, "the run's claims table") if args.claims is not None else None
     stacked = claims_by_stage({k: table for k, (_, table) in read.items()}, env_steps, episodes or None)
-    trends = stage_trends(stacked, cfg.analysis.claims_trend_alpha)
+    trends = stage_trends(stacked, cfg.analysis.claims_trend_alpha, cfg.analysis.claims_alpha)
     drawn = plot_claims_by_stage(stacked, figures / Path(CLAIMS_BY_STAGE_FIGURE).name, trends)
     tables = write_parquet_tables({Path(CLAIMS_BY_STAGE).stem: stacked, Path(CLAIMS_TRENDS).stem: trends}, out)
     if final is not None:

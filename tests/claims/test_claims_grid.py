@@ -18,11 +18,11 @@ from ..test_cli import claims_rows
 @pytest.fixture
 def three_runs(tmp_path) -> dict[str, pd.DataFrame]:
     """Three runs' claims tables in results/: a and b with the recipe's verdict, c without; c lacks C3."""
-    rows = claims_rows({"C2": "holds", "C10": "weaker", "C3": "fails"})
-    tables = {"a": rows.assign(recipe_verdict=["holds", "fails", "weaker"], recipe_effect=[0.5, float("nan"), 2.0]),
-              "b": rows.assign(verdict=["weaker", "weaker", "holds"], effect=[0.1, 0.2, 0.3],
+    rows = claims_rows({"C2": "holds", "C10": "absent", "C3": "opposite"})
+    tables = {"a": rows.assign(recipe_verdict=["holds", "opposite", "absent"], recipe_effect=[0.5, float("nan"), 2.0]),
+              "b": rows.assign(verdict=["absent", "absent", "holds"], effect=[0.1, 0.2, 0.3],
                                recipe_verdict=["not decidable", "holds", "holds"], recipe_effect=[1.5, 2.5, 3.5]),
-              "c": claims_rows({"C2": "not run", "C10": "fails"}).assign(effect=[float("nan"), -1.0])}
+              "c": claims_rows({"C2": "not run", "C10": "opposite"}).assign(effect=[float("nan"), -1.0])}
     for run, table in tables.items():
         (tmp_path / "results" / run / "claims").mkdir(parents=True)
         table.to_parquet(tmp_path / "results" / run / "claims" / "claims.parquet")
@@ -34,11 +34,11 @@ def test_the_table_has_a_row_per_claim_and_each_runs_verdicts_and_effects_recipe
     assert grid["claim"].tolist() == ["C2", "C3", "C10"]  # by number
     assert list(grid.columns) == ["claim", "panel", "a recipe", "a recipe effect", "a verdict", "a effect",
                                   "b recipe", "b recipe effect", "b verdict", "b effect", "c verdict", "c effect"]
-    assert grid["a recipe"].tolist() == ["holds", "weaker", "fails"]
-    assert grid["b verdict"].tolist() == ["weaker", "holds", "weaker"]
-    assert grid["c verdict"].tolist() == ["not run", "-", "fails"] and pd.isna(grid.loc[1, "c effect"])
+    assert grid["a recipe"].tolist() == ["holds", "absent", "opposite"]
+    assert grid["b verdict"].tolist() == ["absent", "holds", "absent"]
+    assert grid["c verdict"].tolist() == ["not run", "-", "opposite"] and pd.isna(grid.loc[1, "c effect"])
     verdicts, effects = headline(grid, ["a", "b", "c"])
-    assert verdicts.loc["C10"].tolist() == ["fails", "holds", "fails"]
+    assert verdicts.loc["C10"].tolist() == ["opposite", "holds", "opposite"]
     assert effects.loc["C10"].tolist() == [0.4, 2.5, -1.0]  # a's recipe has no number there: its seed's effect
 
 
@@ -53,7 +53,7 @@ def test_the_heatmap_colours_each_cell_by_its_verdict_and_prints_its_effect(thre
         cells = {p.get_label(): to_hex(p.get_facecolor()) for p in ax.patches}
         colour = {verdict: to_hex(c) for verdict, c in VERDICT_COLOURS.items()}
         assert cells["C2 a"] == colour["holds"] and cells["C2 b"] == colour["not decidable"]
-        assert cells["C10 c"] == colour["fails"] and cells["C3 c"] == "#ffffff"
+        assert cells["C10 c"] == colour["opposite"] and cells["C3 c"] == "#ffffff"
         assert [t.get_text() for t in ax.texts] == ["0.5", "1.5", "2", "3.5", "0.4", "2.5", "-1"]
         assert [t.get_text() for t in ax.get_yticklabels()] == ["C2", "C3", "C10"]
     finally:
@@ -69,7 +69,7 @@ def test_compare_claims_writes_the_table_and_the_heatmap_of_three_runs(three_run
     assert (tmp_path / "grid.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert main(["compare-claims", "a", "b", "--out", "two.csv"]) == 0
     assert "recipe verdicts: the same for 0 of 3 claims" in capsys.readouterr().out  # the two-run output, as before
-    assert pd.read_csv("two.csv")["a recipe"].tolist() == ["holds", "weaker", "fails"]
+    assert pd.read_csv("two.csv")["a recipe"].tolist() == ["holds", "absent", "opposite"]
 
 
 @pytest.mark.parametrize("args, message", [

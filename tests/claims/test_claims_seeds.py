@@ -15,33 +15,34 @@ def table(verdicts: dict[str, str], reason: str = "") -> pd.DataFrame:
     n = len(verdicts)
     return pd.DataFrame({"claim": list(verdicts), "panel": ["2B"] * n, "statistic": ["a test"] * n,
                          "effect": np.linspace(0.1, 0.5, n), "ci_low": [0.0] * n, "ci_high": [1.0] * n,
-                         "n": [8] * n, "p": [0.01] * n, "verdict": list(verdicts.values()), "reason": [reason] * n},
+                         "n": [8] * n, "p": [0.01] * n, "verdict": list(verdicts.values()),
+                         "parts": [f"1 {v}" for v in verdicts.values()], "reason": [reason] * n},
                         columns=ROW_COLUMNS)
 
 
 def test_agreeing_seeds_count_and_keep_the_reason():
-    sel = table({"C1": "holds", "C2": "fails"}, reason="why")
-    out = with_seed_verdicts(sel, {1: table({"C1": "holds", "C2": "fails"}), 7: table({"C1": "holds", "C2": "fails"})},
-                             selected_seed=3)
-    assert list(out.columns) == [*ROW_COLUMNS[:9], "seed_verdicts", "seeds_agree", "reason"]
+    sel = table({"C1": "holds", "C2": "opposite"}, reason="why")
+    out = with_seed_verdicts(sel, {1: table({"C1": "holds", "C2": "opposite"}),
+                                   7: table({"C1": "holds", "C2": "opposite"})}, selected_seed=3)
+    assert list(out.columns) == [*ROW_COLUMNS[:-1], "seed_verdicts", "seeds_agree", "reason"]
     assert out["seed_verdicts"].tolist() == ["seed 3: holds; seed 1: holds; seed 7: holds",
-                                             "seed 3: fails; seed 1: fails; seed 7: fails"]
-    assert out["seeds_agree"].tolist() == ["3/3 hold", "3/3 fail"]
+                                             "seed 3: opposite; seed 1: opposite; seed 7: opposite"]
+    assert out["seeds_agree"].tolist() == ["3/3 hold", "3/3 opposite"]
     assert out["reason"].tolist() == ["why", "why"]
     pd.testing.assert_frame_equal(out[ROW_COLUMNS], sel)  # the selected seed's numbers and verdicts stay
 
 
 def test_a_flip_is_counted_and_said_in_the_reason():
-    sel = table({"C1": "holds", "C2": "weaker"}, reason="the paper's sign")
-    out = with_seed_verdicts(sel, {1: table({"C1": "weaker", "C2": "weaker"}),
+    sel = table({"C1": "holds", "C2": "absent"}, reason="the paper's sign")
+    out = with_seed_verdicts(sel, {1: table({"C1": "absent", "C2": "absent"}),
                                    7: table({"C1": "holds", "C2": "not decidable"})}, selected_seed=3)
     row = out.set_index("claim").loc["C1"]
-    assert row["verdict"] == "holds" and row["seed_verdicts"] == "seed 3: holds; seed 1: weaker; seed 7: holds"
-    assert row["seeds_agree"] == "2/3 hold, 1/3 weaker"
+    assert row["verdict"] == "holds" and row["seed_verdicts"] == "seed 3: holds; seed 1: absent; seed 7: holds"
+    assert row["seeds_agree"] == "2/3 hold, 1/3 absent"
     assert row["reason"] == ("the paper's sign. The verdict flips between seeds: holds at seeds 3 (selected), 7; "
-                             "weaker at seed 1.")
+                             "absent at seed 1.")
     c2 = out.set_index("claim").loc["C2"]
-    assert c2["seeds_agree"] == "2/3 weaker, 1/3 not decidable" and "flips between seeds" in c2["reason"]
+    assert c2["seeds_agree"] == "2/3 absent, 1/3 not decidable" and "flips between seeds" in c2["reason"]
 
 
 def test_seeds_where_a_claim_did_not_run_are_not_counted():
@@ -57,10 +58,10 @@ def test_seeds_where_a_claim_did_not_run_are_not_counted():
 
 
 def test_no_other_seed_is_the_selected_seed_alone():
-    sel = table({"C1": "holds", "C2": "weaker", "C3": "not run"})
+    sel = table({"C1": "holds", "C2": "absent", "C3": "not run"})
     out = with_seed_verdicts(sel, {}, selected_seed=2)
-    assert out["seeds_agree"].tolist() == ["1/1 hold", "1/1 weaker", "not run (0/1 seeds ran)"]
-    assert out["seed_verdicts"].tolist() == ["seed 2: holds", "seed 2: weaker", "seed 2: not run"]
+    assert out["seeds_agree"].tolist() == ["1/1 hold", "1/1 absent", "not run (0/1 seeds ran)"]
+    assert out["seed_verdicts"].tolist() == ["seed 2: holds", "seed 2: absent", "seed 2: not run"]
 
 
 def test_rerunning_on_its_own_output_replaces_the_columns():
@@ -71,7 +72,7 @@ def test_rerunning_on_its_own_output_replaces_the_columns():
 
 
 def test_helpers_read_a_mapping_selected_seed_first():
-    assert agreement({3: "fails", 1: "holds"}) == "1/2 hold, 1/2 fail"
+    assert agreement({3: "opposite", 1: "holds"}) == "1/2 hold, 1/2 opposite"
     assert agreement({3: "not run", 1: "not run"}) == "not run (0/2 seeds ran)"
     assert flip_sentence({3: "holds", 1: "holds", 7: "not run"}) == ""
 
@@ -91,6 +92,6 @@ def test_the_claims_page_shows_seeds_agree_beside_the_verdict_when_the_table_has
     from efish.claims.report import claims_markdown
 
     sel = table({"C1": "holds"})
-    page = claims_markdown(with_seed_verdicts(sel, {1: table({"C1": "fails"})}, selected_seed=3), "header")
-    assert "| verdict | seeds_agree | reason |" in page and "| holds | 1/2 hold, 1/2 fail |" in page
+    page = claims_markdown(with_seed_verdicts(sel, {1: table({"C1": "opposite"})}, selected_seed=3), "header")
+    assert "| verdict | parts | seeds_agree | reason |" in page and "| holds | 1 holds | 1/2 hold, 1/2 opposite |" in page
     assert "seeds_agree" not in claims_markdown(sel, "header")

@@ -23,8 +23,9 @@ import pandas as pd
 from ..config.recorded import recorded_conditions
 from ..config.schema import EfishConfig
 from ..layout import assay_table, parse_table
+from .deltas import smallest_effect
 from .statistics import bootstrap_ci
-from .verdicts import MIN_UNITS, Outcome, Part, combine, judge, unreachable
+from .verdicts import MIN_UNITS, Outcome, Part, combine, decide_outcome, interval_level
 
 #: ``ci_method`` of an interval no test inverts: every such interval resamples episodes (:meth:`Context.ci`).
 BOOTSTRAP = "bootstrap percentile over episodes"
@@ -42,15 +43,15 @@ class MissingTable(LookupError):
         super().__init__(f"needs {path}, which this run lacks ({what} has not run at this scale)")
 
 
-def evaluate(label: str, statistic: str, compute: Callable[[], Outcome], alpha: float, decides: bool = True) -> Part:
+def evaluate(label: str, statistic: str, compute: Callable[[], Outcome], alpha: float, decides: bool = True,
+             claim: str = "") -> Part:
     """Run one part: a missing table or degenerate data (ValueError) is a ``not run`` part whose reason says why.
 
-    The part's ``p`` is the one its verdict rests on: the TOST p for a "no
-    difference" part (sign 0), else the difference test's. Fewer than
-    :data:`~efish.claims.verdicts.MIN_UNITS` units is ``not run``; a test that
-    cannot reach p < alpha at its n (``Outcome.p_floor``; for a "no difference"
-    part, its equivalence test within the margin) is ``not decidable`` and says
-    so, rather than weaker (:func:`~efish.claims.verdicts.unreachable`).
+    The part is decided against its smallest effect of interest (``claim``'s
+    delta for ``label``, :func:`efish.claims.deltas.smallest_effect`, scaled by
+    the outcome's ``reference`` where it is relative) by
+    :func:`~efish.claims.verdicts.decide_outcome`. Fewer than
+    :data:`~efish.claims.verdicts.MIN_UNITS` units is ``not run``.
     """
     try:
         out = compute()
@@ -58,25 +59,29 @@ def evaluate(label: str, statistic: str, compute: Callable[[], Outcome], alpha: 
         return Part(label, statistic, reason=str(exc).strip("'\""), decides=decides)
     except KeyError as exc:  # a table from an older run without a column this claim reads
         return Part(label, statistic, reason=f"a table lacks the column or key {exc}", decides=decides)
-    p = out.p_equiv if out.sign == 0 and out.verdict is None else out.p
-    base = Part(label, statistic, float(out.effect), tuple(map(float, out.ci)), int(out.n), float(p), decides=decides,
-                sign=out.sign, ci_method=out.ci_method or (BOOTSTRAP if np.isfinite(out.ci).all() else ""),
-                margin=float(out.margin), margin_ratio=float(out.margin_ratio), family=int(out.family),
-                p_floor=float(out.p_floor))
+    smallest = smallest_effect(claim, label)
+    reference = float(out.reference)
+    delta = (smallest.absolute(reference) if smallest.relative_to is None or np.isfinite(reference)
+             else np.nan)
+    base = Part(label, statistic, float(out.effect), tuple(map(float, out.ci)), int(out.n), float(out.p),
+                decides=decides, sign=out.sign,
+                ci_method=out.ci_method or (BOOTSTRAP if np.isfinite(out.ci).all() else ""),
+                family=int(out.family), p_floor=float(out.p_floor), reference=reference, delta=float(delta))
 
-    def judged(verdict: str, *why: str) -> Part:
-        return dataclasses.replace(base, verdict=verdict, reason="; ".join(r for r in why if r))
+    def judged(verdict: str, *why: str, p_opposite: float = np.nan) -> Part:
+        return dataclasses.replace(base, verdict=verdict, reason="; ".join(r for r in why if r),
+                                   p_opposite=p_opposite)
     if out.verdict is not None:
         return judged(out.verdict, out.reason)
     if out.n < MIN_UNITS:
         return judged("not run", f"n = {out.n}: a test needs at least {MIN_UNITS} units", out.reason)
-    if not (np.isfinite(out.effect) and np.isfinite(p)):
+    if not (np.isfinite(out.effect) and np.isfinite(out.p)):
         return judged("not run", out.reason or "no test result")
-    verdict, why = judge(out.effect, out.p, out.sign, alpha, out.p_equiv, out.margin)
-    if unreachable(verdict, out.p_floor, alpha, out.sign):
-        return judged("not decidable", f"cannot reach significance at n = {out.n} (the smallest p its test can give "
-                                       f"is {out.p_floor:.3g})", out.reason)
-    return judged(verdict, why, out.reason)
+    if not np.isfinite(delta):
+        return judged("not decidable", f"no finite {smallest.relative_to} for a delta of {smallest.shown}",
+                      out.reason)
+    verdict, why, p_opposite = decide_outcome(out, delta, alpha)
+    return judged(verdict, why, out.reason, p_opposite=p_opposite)
 
 
 @dataclass
@@ -108,13 +113,18 @@ class Context:
 
     def ci(self, data: pd.DataFrame, stat: Callable[[pd.DataFrame], float], units_: Iterable[str] = ("episode",),
            strata: str | None = "condition", resamples: int | None = None) -> tuple[float, float]:
-        """Bootstrap interval of ``stat`` over episodes (within each condition), seeded per claim."""
+        """Bootstrap interval of ``stat`` over episodes (within each condition) at the parts' level (:meth:`level`),
+        seeded per claim."""
         strata = strata if strata in data.columns else None
         n = self.cfg.analysis.claims_resamples if resamples is None else resamples
-        return bootstrap_ci(data, stat, list(units_), n, self.rng, strata)
+        return bootstrap_ci(data, stat, list(units_), n, self.rng, strata, self.level())
 
     def part(self, label: str, statistic: str, compute: Callable[[], Outcome], decides: bool = True) -> Part:
-        return evaluate(label, statistic, compute, self.cfg.analysis.claims_alpha, decides)
+        return evaluate(label, statistic, compute, self.cfg.analysis.claims_alpha, decides, self.claim)
+
+    def level(self, family: int = 1) -> float:
+        """The level of a part's interval, 1 - 2 alpha / ``family`` (:func:`~efish.claims.verdicts.interval_level`)."""
+        return interval_level(self.cfg.analysis.claims_alpha, family)
 
 
 @dataclass(frozen=True)
@@ -142,7 +152,7 @@ class Claim:
         """The claim's row (:data:`~efish.claims.verdicts.ROW_COLUMNS`, :func:`~efish.claims.verdicts.combine`) and
         the parts it combines."""
         found = self.parts(tables, cfg)
-        return combine(self.id, self.panel, found), found
+        return combine(self.id, self.panel, found, cfg.analysis.claims_alpha), found
 
     def run(self, tables: Tables, cfg: EfishConfig) -> dict:
         """The claim's row (:data:`~efish.claims.verdicts.ROW_COLUMNS`)."""

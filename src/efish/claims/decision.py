@@ -105,6 +105,7 @@ def over_seeds(effects: Sequence[float], sign: int | None, delta: float, alpha: 
     """The recipe's decision of a part from the seeds' ``effects``: the t interval at 1 - 2 alpha / ``family``
     (``family``: the comparisons the part's test shares its alpha with, Bonferroni) decided by :func:`decide`."""
     mean, low, high = t_interval(effects, 1 - 2 * alpha / family)
+    mean, low, high = float(mean), float(low), float(high)
     y = np.asarray(effects, np.float64)
     se, df = float(y.std(ddof=1)) / np.sqrt(y.size), y.size - 1
     if sign is None:

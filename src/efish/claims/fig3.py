@@ -35,13 +35,13 @@ def c4(ctx: Context) -> list[Part]:
         res = power_law_vs_exponential_clustered(ids, xmin)
         if not np.isfinite(res["p"]):
             raise ValueError(res["reason"] or "no clustered test result")
-        half = float(sps.t.ppf(1 - ctx.cfg.analysis.claims_alpha / 2, res["df"])) * res["se"]
+        half = float(sps.t.ppf(0.5 + ctx.level() / 2, res["df"])) * res["se"]
         mean = float(res["mean_cluster_sum"])
         note = (f"alpha {res['alpha']:.3g}, xmin {xmin:g} steps, R {res['R']:.3g} over {res['n']} IDIs "
                 f"(p {res['p_iid']:.3g} if they were independent)")
         return Outcome(mean, float(res["p"]), int(res["n_clusters"]), +1, (mean - half, mean + half),
                        "; ".join(r for r in (note, str(res["reason"] or "")) if r),
-                       ci_method="inverts the clustered t-test")
+                       ci_method=f"inverts the clustered t-test, level {ctx.level():.3g}")
     return [ctx.part("power law", "mean over episodes of the summed loglikelihood ratio of a discrete power law vs "
                      "the exponential (IDIs in steps >= xmin, wide2; powerlaw discrete=True, as the authors); t-test "
                      "across episodes", compute)]
@@ -151,7 +151,7 @@ def c5(ctx: Context) -> list[Part]:
         reason = (f"{test.k} distance bins over {test.n} episodes that reach them all" if np.isfinite(test.p) else
                   "fewer than 3 distance bins reached by half the episodes, fewer than 2 such episodes, "
                   "or a constant rate")
-        return Outcome(test.excess, test.p, test.n, None, _excess_interval(rates, ctx.cfg.analysis.claims_alpha),
+        return Outcome(test.excess, test.p, test.n, None, _excess_interval(rates, 1 - ctx.level()),
                        reason, ci_method=JACKKNIFE)
     stat = ("Friedman test of the episodes' mean EOD rate across the distance bins of "
             "docs/methods/analyses.md#analysis-signalling (wide2), the episode a block; effect Kendall's W minus its "

@@ -3,7 +3,7 @@
 Conditions of one assay
 share their episode seeds, so they are compared paired over episodes with a
 Holm correction over the conditions compared with the same control; "no
-difference" parts are equivalence tests; food parts are not decidable while
+difference" parts are decided against delta as an equivalence margin; food parts are not decidable while
 the control eats every pellet; Theil T is compared above its equal-share null
 where totals differ (the rules: docs/claims/index.md).
 
@@ -15,12 +15,13 @@ from __future__ import annotations
 import functools
 import re
 
+import numpy as np
 import pandas as pd
 
 from ..layout import analysis_table
 from .context import Context, claim
-from .parts import ceiling, mann_whitney_part, margin_for, paired_part, present, spearman_part, with_margin
-from .statistics import excess_theil_per_episode, pooled_sd, welch_tost
+from .parts import ceiling, mann_whitney_part, paired_part, present, spearman_part
+from .statistics import excess_theil_per_episode, welch_difference
 from .verdicts import Outcome, Part
 
 # ablation conditions are named by the receptor classes left on (config/assay/ablation4.yaml)
@@ -136,12 +137,9 @@ def c13(ctx: Context) -> list[Part]:
     def theil() -> Outcome:
         d = layouts().dropna(subset=["excess_theil"])
         x, c = (d.loc[d["condition"] == g, "excess_theil"].to_numpy() for g in ("patchy4", "uniform4"))
-        margin, alpha = margin_for(ctx, c, pooled_sd(x, c)), ctx.cfg.analysis.claims_alpha
-        diff, p, p_equiv, ci = welch_tost(x, c, margin[0], alpha)
-        # the Welch TOST of the same samples shifted to a zero difference: t.sf(margin / SE) at Welch's df
-        p_zero = welch_tost(x - diff, c, margin[0], alpha)[2]
-        return with_margin(ctx, Outcome(diff, p, len(d), 0, ci, ci_method="inverts Welch's t-test"), margin,
-                           p_equiv, p_zero)
+        diff, p, ci = welch_difference(x, c, ctx.level())
+        return Outcome(diff, p, len(d), 0, ci, ci_method=f"inverts Welch's t-test, level {ctx.level():.3g}",
+                       reference=float(np.median(c)) if c.size else np.nan)
 
     def sweep(series: str, value: str) -> Outcome:
         return spearman_part(ctx, _npatch(ctx).query("series == @series"), "n", value, -1)
@@ -149,7 +147,7 @@ def c13(ctx: Context) -> list[Part]:
     return [ctx.part("food, patchy vs uniform", "Hodges-Lehmann shift of the episode food, patchy4 minus uniform4; "
                      "Mann-Whitney", food),
             ctx.part("excess Theil, patchy vs uniform (equivalent)", "mean episode Theil T above its equal-share "
-                     "null at the episode's total, patchy4 minus uniform4; Welch t-test and TOST", theil),
+                     "null at the episode's total, patchy4 minus uniform4; Welch t-test", theil),
             ctx.part("iso per-fish food vs n", rho.format("iso (fixed total food)", "food per fish"),
                      functools.partial(sweep, "iso", "food_per_fish")),
             ctx.part("free per-fish food vs n", rho.format("free", "food per fish"),

@@ -25,7 +25,6 @@ from .parts import (
     present,
     spearman_part,
     stat_row,
-    unpaired_equivalence,
 )
 from .statistics import mean_diff
 from .verdicts import Outcome, Part
@@ -63,7 +62,7 @@ def c14(ctx: Context) -> list[Part]:
         a = people()
         a = a[(a["role"] == "A") & ((a["setting"] != "alone") | a["condition"].isin(controls))]
         a = a.assign(setting=np.where(a["setting"] == "alone", "alone", "social"))
-        return unpaired_equivalence(ctx, a, "food_eaten", "setting", "social", "alone")
+        return mann_whitney_part(ctx, a, "food_eaten", "setting", "social", "alone", 0)
 
     def b_size() -> Outcome:
         b = people().query("role == 'B' and setting != 'alone'")
@@ -72,7 +71,7 @@ def c14(ctx: Context) -> list[Part]:
     return ([ctx.part(f"B social, {c}", stat.format(c), functools.partial(b_social, c))
              for c in social_conditions(configs)]
             + [ctx.part("A social vs alone (equivalent)", "Hodges-Lehmann shift of the food of A with B against A alone at A's sizes "
-                        "(size classes pooled, one alone condition per class); Mann-Whitney and TOST", a_unaffected),
+                        "(size classes pooled, one alone condition per class); Mann-Whitney", a_unaffected),
                ctx.part("B food vs B size", "Spearman rho of B's food against B's size over the social conditions",
                         b_size)])
 
@@ -120,7 +119,9 @@ def _confronting(ctx: Context) -> Outcome:
     both = per[per["label"].isin(["confronting", other])]
     both = both[both.groupby(["condition", "episode"])["label"].transform("nunique") == 2]
     out = paired_difference(ctx, both, "confronting", other, value="rate", key="label")
-    return dataclasses.replace(out, reason="; ".join(r for r in (out.reason, f"next-highest class: {other}") if r))
+    reference = float(both.loc[both["label"] == other, "rate"].median())  # the next-highest class's median rate
+    return dataclasses.replace(out, reason="; ".join(r for r in (out.reason, f"next-highest class: {other}") if r),
+                               reference=reference)
 
 
 @claim("C16", "5K-P", "larger agents chase; biting peaks early in bouts; confronting bouts bite most",

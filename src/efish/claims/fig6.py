@@ -47,8 +47,8 @@ def c17(ctx: Context) -> list[Part]:
     def interaction() -> Outcome:
         d = groupsize_episodes()
         on = (d["knollenorgans"] == "K").to_numpy(np.float64)
-        b, p, n, ci = interaction_slope(d["n_agents"], d["d_eff"], on, ctx.cfg.analysis.claims_alpha)
-        return Outcome(b, p, n, +1, ci, ci_method="inverts the t-test")
+        b, p, n, ci = interaction_slope(d["n_agents"], d["d_eff"], on, 1 - ctx.level())
+        return Outcome(b, p, n, +1, ci, ci_method=f"inverts the t-test, level {ctx.level():.3g}")
     return [ctx.part("low-dimensional", f"Hodges-Lehmann estimate over episodes of the agents' mean D_eff / width ({width}) "
                      f"minus {a.claims_deff_fraction} (patchy4); Wilcoxon", low),
             ctx.part("D_eff grows with N, K on", "Spearman rho(mean D_eff of the episode, N), Knollenorgans on "
@@ -178,8 +178,11 @@ def c21(ctx: Context) -> list[Part]:
         """Per episode, its agents' mean wideband power far minus near (power_near_far), across episodes."""
         wide = ctx.table(POWER_NEAR_FAR).pivot(index=AGENT_EPISODE, columns="where", values="wideband_power")
         wide = wide.reindex(columns=["near", "far"])
-        diff = (wide["far"] - wide["near"]).dropna().rename("diff").reset_index()
-        return one_sample_part(ctx, per_episode(diff, "diff"), "diff", 0.0, +1)
+        both = wide[["near", "far"]].dropna()
+        diff = (both["far"] - both["near"]).rename("diff").reset_index()
+        out = one_sample_part(ctx, per_episode(diff, "diff"), "diff", 0.0, +1)
+        near = per_episode(both["near"].rename("near").reset_index(), "near")["near"]
+        return dataclasses.replace(out, reference=float(near.median()))  # the episodes' median power near
 
     def smaller() -> Outcome:
         """Per episode, the smaller agent's wideband power minus the larger's (paired within the episode; dynamics
@@ -188,7 +191,8 @@ def c21(ctx: Context) -> list[Part]:
         by_role = d.pivot_table(index=["condition", "episode"], columns="role", values="wideband_power")
         by_role = by_role.reindex(columns=["smaller", "larger"]).dropna()
         diff = (by_role["smaller"] - by_role["larger"]).rename("diff").reset_index()
-        return one_sample_part(ctx, diff, "diff", 0.0, +1)
+        out = one_sample_part(ctx, diff, "diff", 0.0, +1)
+        return dataclasses.replace(out, reference=float(by_role["larger"].median()))  # the larger agent's median
     return [ctx.part("far > near", f"Hodges-Lehmann estimate over episodes of the agents' mean wideband power with "
                      f"the conspecific beyond {a.claims_far_cm:g} cm minus within {a.claims_near_cm:g} cm; Wilcoxon "
                      "signed-rank", near_far),

@@ -53,19 +53,24 @@ def claims_markdown(table: pd.DataFrame, header: str, trends: Mapping[str, str] 
     """The claims table as markdown under a ``header`` line.
 
     With the recipe's verdict (:mod:`efish.claims.recipe`) it is the headline: claim, panel, recipe verdict,
-    recipe effect [CI] over its seeds; then the selected seed's statistic, effect [95% CI], n, p and verdict (the
-    paper's procedure), seeds_agree (each top seed's own verdict, :mod:`efish.claims.seeds`) and the reasons (what
+    recipe effect [CI] over its seeds and the tally of its parts' verdicts; then the selected seed's statistic, effect
+    [CI] (each part's interval at level 1 - 2 alpha / family, the one its verdict reads), n, p, verdict and the
+    tally of its parts' verdicts, seeds_agree (each top seed's own verdict, :mod:`efish.claims.seeds`) and the reasons (what
     docs/claims/results.md quotes and the Snakemake report shows). With ``trends`` (claim -> line,
     :func:`efish.claims.stages.trend_lines`) the section :func:`along_training` follows."""
     shown = pd.DataFrame({"claim": table["claim"], "panel": table["panel"]})
     recipe = has_recipe(table)
     if recipe:
         shown["recipe verdict"] = table["recipe_verdict"]
+        if "recipe_parts" in table.columns:
+            shown["recipe parts"] = table["recipe_parts"]
         shown["recipe effect [CI] (seeds)"] = [f"{e} ({k})" for e, k in zip(_effects(table, "recipe_"),
                                                                             table["recipe_seeds"], strict=True)]
     seed = "selected seed's " if recipe else ""
-    shown = shown.assign(**{"statistic": table["statistic"], f"{seed}effect [95% CI]": _effects(table),
+    shown = shown.assign(**{"statistic": table["statistic"], f"{seed}effect [CI]": _effects(table),
                             "n": table["n"], "p": [_num(p) for p in table["p"]], f"{seed}verdict": table["verdict"]})
+    if "parts" in table.columns:
+        shown[f"{seed}parts"] = table["parts"]
     if "seeds_agree" in table.columns:
         shown["seeds_agree"] = table["seeds_agree"]
     shown["reason"] = table["reason"]
@@ -106,7 +111,8 @@ def load_claims(where: str | Path, results_root: str | Path = RESULTS_ROOT) -> t
 def compare_claims(a: pd.DataFrame, b: pd.DataFrame, names: tuple[str, str] = ("A", "B")) -> pd.DataFrame:
     """Two claims tables side by side, one row per claim: each run's recipe verdict (its top seeds together,
     :mod:`efish.claims.recipe`; '-' for a run whose table has none), its selected seed's verdict, seeds_agree (the
-    verdicts across its top seeds; '-' where absent), effect [95% CI] and n, and whether a verdict moved: ``moved``
+    verdicts across its top seeds; '-' where absent), effect [CI] (the selected seed's, at the level its verdict
+    reads) and n, and whether a verdict moved: ``moved``
     marks the recipe verdict when both runs have one, else the selected seed's. A claim only one table has shows '-'
     on the other side."""
     def side(t: pd.DataFrame, name: str) -> pd.DataFrame:
@@ -114,7 +120,7 @@ def compare_claims(a: pd.DataFrame, b: pd.DataFrame, names: tuple[str, str] = ("
         recipe = t["recipe_verdict"] if has_recipe(t) else "-"
         return pd.DataFrame({"claim": t["claim"], "panel": t["panel"], f"{name} recipe": recipe,
                              f"{name} verdict": t["verdict"], f"{name} seeds_agree": agree,
-                             f"{name} effect [95% CI]": _effects(t), f"{name} n": t["n"]})
+                             f"{name} effect [CI]": _effects(t), f"{name} n": t["n"]})
 
     if names[0] == names[1]:
         names = (f"{names[0]} (A)", f"{names[1]} (B)")
@@ -131,15 +137,15 @@ def compare_claims(a: pd.DataFrame, b: pd.DataFrame, names: tuple[str, str] = ("
 def agreement_lines(a: pd.DataFrame, b: pd.DataFrame, names: tuple[str, str] = ("A", "B")) -> list[str]:
     """How far two claims tables agree, one line per kind of verdict both have (the recipe's, the selected
     seed's): on how many of the claims both list the verdict is the same, and the claims that hold in one and
-    fail in the other (what the stability run of docs/claims/results.md reports)."""
+    are opposite in the other (what the stability run of docs/claims/results.md reports)."""
     both = a.merge(b, on="claim", suffixes=("_a", "_b"))
     lines = []
     for column, what in (("recipe_verdict", "recipe verdicts"), ("verdict", "selected seeds' verdicts")):
         if not (has_recipe(a) and has_recipe(b)) and column == "recipe_verdict":
             continue
         x, y = both[f"{column}_a"], both[f"{column}_b"]
-        flips = both.loc[((x == "holds") & (y == "fails")) | ((x == "fails") & (y == "holds")), "claim"].tolist()
-        lines.append(f"{what}: the same for {int((x == y).sum())} of {len(both)} claims; holds in one and fails in the "
-                     f"other: {', '.join(flips) if flips else 'none'} ({names[0]} vs {names[1]})")
+        flips = both.loc[((x == "holds") & (y == "opposite")) | ((x == "opposite") & (y == "holds")), "claim"].tolist()
+        lines.append(f"{what}: the same for {int((x == y).sum())} of {len(both)} claims; holds in one and opposite in "
+                     f"the other: {', '.join(flips) if flips else 'none'} ({names[0]} vs {names[1]})")
     return lines
 

@@ -6,22 +6,22 @@ pipeline computes every claim for the selected seed and for each of the other
 and :func:`with_seed_verdicts` adds to the selected seed's table:
 
 - ``seed_verdicts``: each seed's verdict, the selected seed first, then the
-  others in the order given (the ranking's): ``"seed 3: holds; seed 1: weaker;
+  others in the order given (the ranking's): ``"seed 3: holds; seed 1: absent;
   seed 7: holds"``;
 - ``seeds_agree``: the verdicts of the seeds where the claim ran, counted over
-  those seeds: ``"3/3 hold"``, ``"2/3 hold, 1/3 weaker"``. Seeds where it did
+  those seeds: ``"3/3 hold"``, ``"2/3 hold, 1/3 absent"``. Seeds where it did
   not run are named after the count: ``"1/1 hold (other seeds: not run)"``
   when only the selected seed ran (e.g. a claim on the homing assay, whose
   policies are recipes that do not depend on the seed), ``"2/2 hold (seed 7:
   not run)"`` otherwise; ``"not run (0/3 seeds ran)"`` when no seed ran. The
-  counts use the plural verb: ``hold`` for *holds*, ``fail`` for *fails*;
-  ``weaker`` and ``not decidable`` are unchanged. Counts follow the order of
+  counts use the plural verb ``hold`` for *holds*; the other verdicts are
+  unchanged. Counts follow the order of
   :data:`VERDICTS`. With no other seed (``scale.top_seeds`` <= 1) it is the
   selected seed's alone: ``"1/1 hold"``.
 
 When the seeds that ran disagree, the ``reason`` gains one sentence saying so,
 e.g. ``"The verdict flips between seeds: holds at seeds 3 (selected), 7;
-weaker at seed 1."``. The other columns (effect, interval, n, p, verdict) stay
+absent at seed 1."``. The other columns (effect, interval, n, p, verdict) stay
 the selected seed's.
 
 Pure pandas: it reads tables, never the simulator.
@@ -37,10 +37,11 @@ from .verdicts import VERDICTS
 
 __all__ = ["SEED_COLUMNS", "VERDICTS", "agreement", "flip_sentence", "with_seed_verdicts"]
 
-#: The columns :func:`with_seed_verdicts` adds, right after ``verdict``.
+#: The columns :func:`with_seed_verdicts` adds, after ``verdict`` and its ``parts`` tally (before ``reason``).
 SEED_COLUMNS = ("seed_verdicts", "seeds_agree")
 #: How a verdict reads after a count of seeds ("2/3 hold").
-PLURAL = {"holds": "hold", "weaker": "weaker", "fails": "fail", "not decidable": "not decidable"}
+PLURAL = {"holds": "hold", "absent": "absent", "opposite": "opposite", "inconclusive": "inconclusive",
+          "not decidable": "not decidable"}
 
 
 def seed_list(seeds: list[int], selected: int | None = None) -> str:
@@ -52,8 +53,8 @@ def seed_list(seeds: list[int], selected: int | None = None) -> str:
 def agreement(verdicts: Mapping[int, str]) -> str:
     """``seeds_agree`` for one claim from its verdict per seed (the selected seed first).
 
-    >>> agreement({3: "holds", 1: "weaker", 7: "holds"}), agreement({3: "holds", 1: "not run"})
-    ('2/3 hold, 1/3 weaker', '1/1 hold (other seeds: not run)')
+    >>> agreement({3: "holds", 1: "absent", 7: "holds"}), agreement({3: "holds", 1: "not run"})
+    ('2/3 hold, 1/3 absent', '1/1 hold (other seeds: not run)')
     """
     seeds = list(verdicts)
     ran = [s for s in seeds if verdicts[s] != "not run"]
@@ -102,7 +103,7 @@ def _verdicts(table: pd.DataFrame, what: str) -> dict[str, str]:
 
 def with_seed_verdicts(selected: pd.DataFrame, others: Mapping[int, pd.DataFrame],
                        selected_seed: int) -> pd.DataFrame:
-    """The selected seed's claims table with ``seed_verdicts`` and ``seeds_agree`` after ``verdict``.
+    """The selected seed's claims table with ``seed_verdicts`` and ``seeds_agree`` after ``verdict`` (and ``parts``).
 
     ``selected``: the selected seed's table (the columns of
     :data:`efish.claims.verdicts.ROW_COLUMNS`); ``others``: the other top
@@ -122,7 +123,7 @@ def with_seed_verdicts(selected: pd.DataFrame, others: Mapping[int, pd.DataFrame
     per_claim = [{selected_seed: own[c], **{seed: v.get(c, "not run") for seed, v in theirs.items()}}
                  for c in selected["claim"]]
     out = selected.drop(columns=[c for c in SEED_COLUMNS if c in selected.columns]).reset_index(drop=True)
-    at = list(out.columns).index("verdict") + 1
+    at = list(out.columns).index("parts" if "parts" in out.columns else "verdict") + 1
     out.insert(at, "seed_verdicts", ["; ".join(f"seed {s}: {v}" for s, v in verdicts.items())
                                      for verdicts in per_claim])
     out.insert(at + 1, "seeds_agree", [agreement(verdicts) for verdicts in per_claim])

@@ -28,18 +28,16 @@ __all__ = ["STAGE_COLUMNS", "TREND_COLUMNS", "TRENDS", "claims_by_stage", "stage
            "wls_slope"]
 
 #: The columns of a stacked table (:func:`claims_by_stage`); ``episodes`` (per condition) follows when given.
-STAGE_COLUMNS = ["claim", "part", "stage", "env_steps", "effect", "ci_low", "ci_high", "n", "p", "verdict", "sign"]
+STAGE_COLUMNS = ["claim", "part", "stage", "env_steps", "effect", "ci_low", "ci_high", "n", "p", "verdict", "sign",
+                 "family"]
 #: What a stage's parts table must hold (efish claims' claim_parts.parquet).
-_PART_NEEDS = ["claim", "part", "effect", "ci_low", "ci_high", "n", "p", "verdict", "sign"]
+_PART_NEEDS = ["claim", "part", "effect", "ci_low", "ci_high", "n", "p", "verdict", "sign", "family"]
 TOWARD, STABLE, AWAY, UNDECIDED = TRENDS = ("moving toward the paper's sign", "stable", "moving away",
                                             "not decidable")
 TREND_COLUMNS = ["claim", "part", "trend", "slope", "slope_ci_low", "slope_ci_high", "p", "test", "n_stages",
                  "reason"]
 #: A trend needs this many stages with a finite effect and interval (two points always lie on a line).
 MIN_STAGES = 3
-#: The claims' intervals are 95% bootstrap intervals (efish.claims.statistics.bootstrap_ci): half-width / Z95
-#: is the normal approximation of the effect's standard error.
-Z95 = float(sps.norm.ppf(0.975))
 
 
 # ------------------------------------------------------------------ stacking
@@ -122,7 +120,16 @@ def _paper_sign(signs: pd.Series) -> int | None:
     return None if finite.empty else int(finite.iloc[0])
 
 
-def _part_trend(g: pd.DataFrame, alpha: float) -> dict:
+def _standard_errors(g: pd.DataFrame, claims_alpha: float) -> np.ndarray:
+    """Each stage's standard error of the effect: its interval's half-width over the normal quantile of the
+    interval's level, 1 - 2 ``claims_alpha`` / family (:func:`efish.claims.verdicts.interval_level`; a family of
+    NaN, or none in the table, counts as 1)."""
+    family = g["family"].astype(np.float64).fillna(1.0).to_numpy() if "family" in g else np.ones(len(g))
+    half = (g["ci_high"] - g["ci_low"]).to_numpy(np.float64) / 2
+    return half / sps.norm.ppf(1 - claims_alpha / family)
+
+
+def _part_trend(g: pd.DataFrame, alpha: float, claims_alpha: float) -> dict:
     """One part's row of :data:`TREND_COLUMNS` (without claim and part) from its stages' rows."""
     sign = _paper_sign(g["sign"])
     absolute = sign in (0, None)
@@ -130,8 +137,8 @@ def _part_trend(g: pd.DataFrame, alpha: float) -> dict:
     # the slope's sign that moves toward the paper: the paper's sign; a shrinking |effect| where the paper reports
     # no difference; a growing |effect| where it reports a difference of either sign
     toward = {None: +1, 0: -1}.get(sign, sign)
-    half = (g["ci_high"] - g["ci_low"]).to_numpy(np.float64) / 2
-    ok = (np.isfinite(g[["effect", "ci_low", "ci_high"]].to_numpy(np.float64)).all(axis=1) & (half > 0)
+    se = _standard_errors(g, claims_alpha)
+    ok = (np.isfinite(g[["effect", "ci_low", "ci_high"]].to_numpy(np.float64)).all(axis=1) & (se > 0)
           & (g["env_steps"].to_numpy(np.float64) > 0))
     row = {"trend": UNDECIDED, "slope": np.nan, "slope_ci_low": np.nan, "slope_ci_high": np.nan, "p": np.nan,
            "test": f"WLS slope of {response} on log10 env steps", "n_stages": int(ok.sum()), "reason": ""}
@@ -141,7 +148,7 @@ def _part_trend(g: pd.DataFrame, alpha: float) -> dict:
     effect = g["effect"].to_numpy(np.float64)[ok]
     try:
         b, se, factor = wls_slope(np.log10(g["env_steps"].to_numpy(np.float64)[ok]),
-                                  np.abs(effect) if absolute else effect, half[ok] / Z95)
+                                  np.abs(effect) if absolute else effect, se[ok])
     except ValueError as exc:
         return {**row, "reason": str(exc)}
     p = float(2 * sps.norm.sf(abs(b) / se))
@@ -152,13 +159,13 @@ def _part_trend(g: pd.DataFrame, alpha: float) -> dict:
             "reason": reason}
 
 
-def stage_trends(stacked: pd.DataFrame, alpha: float = 0.05) -> pd.DataFrame:
+def stage_trends(stacked: pd.DataFrame, alpha: float = 0.05, claims_alpha: float = 0.05) -> pd.DataFrame:
     """Per part of a stacked table (:func:`claims_by_stage`), whether its effect is still moving: one row of
     :data:`TREND_COLUMNS`, trend one of :data:`TRENDS`.
 
     The test: the weighted least-squares slope of the part's effect against log10 env steps, each stage weighted
-    by 1 / SE^2 with SE = its 95% interval's half-width / 1.96 (the normal approximation of the bootstrap
-    interval), a two-sided z-test of the slope at ``alpha`` (``analysis.claims_trend_alpha``), and a 1 - alpha
+    by 1 / SE^2 with SE = its interval's half-width over the normal quantile of the interval's level (1 - 2
+    ``claims_alpha`` / family, ``analysis.claims_alpha``; the normal approximation), a two-sided z-test of the slope at ``alpha`` (``analysis.claims_trend_alpha``), and a 1 - alpha
     interval of it (:func:`wls_slope`, which widens the SE when the stages scatter beyond their intervals).
     Significant in the paper's sign: *moving toward the paper's sign*; significant against it: *moving away*;
     else *stable* (no trend this test can see). For a part the paper reports as no difference (sign 0) the
@@ -169,7 +176,7 @@ def stage_trends(stacked: pd.DataFrame, alpha: float = 0.05) -> pd.DataFrame:
     Why this test: with 3-5 stages a rank test cannot reach p < 0.05 at all (Spearman with 4 points has a
     smallest two-sided p of 0.083), and an unweighted regression of 3-5 effects throws away what each stage
     knows about its own precision. The stages' effects come from independent evaluation episodes, so given the
-    policies their sampling errors are independent, and each stage's bootstrap interval measures its own error:
+    policies their sampling errors are independent, and each stage's interval measures its own error:
     weighting by it lets a tight late stage count more than a noisy early one (an early stage may run fewer
     episodes). Log env steps because learning curves move by orders of magnitude of experience (stages at 1/4,
     1/2, 3/4, 1 of the steps). The folded |effect| of a sign-0 part is biased away from 0 near 0; it only makes
@@ -178,7 +185,7 @@ def stage_trends(stacked: pd.DataFrame, alpha: float = 0.05) -> pd.DataFrame:
     missing = [c for c in ("claim", "part", "env_steps", "effect", "ci_low", "ci_high", "sign") if c not in stacked]
     if missing:
         raise ValueError(f"the stacked table has no column {', '.join(missing)}: is it claims_by_stage's?")
-    rows = [{"claim": claim, "part": part, **_part_trend(g, alpha)}
+    rows = [{"claim": claim, "part": part, **_part_trend(g, alpha, claims_alpha)}
             for (claim, part), g in stacked.groupby(["claim", "part"], sort=False)]
     return pd.DataFrame(rows, columns=TREND_COLUMNS).astype({"n_stages": "int64"})
 

@@ -12,12 +12,8 @@
   of one assay share their episode seeds (same starts, same food), so episode
   ``e`` of one condition is the natural pair of episode ``e`` of the control;
   pairing removes the between-episode variance that an unpaired test keeps.
-- :func:`equivalence_margin`, :func:`tost_paired`, :func:`tost_unpaired`:
-  two one-sided tests (TOST) for a statement the paper reports as "no
-  difference". A large n makes equivalence easier to show, where "p >= 0.05"
-  made it harder. The tests are the rank tests of the difference (Wilcoxon
-  signed-rank on shifted differences; Mann-Whitney on a shifted sample), so an
-  "n.s." part and its neighbours use the same kind of test.
+- :func:`welch_difference`: a difference of means with its Welch test and
+  interval (C13's excess Theil T, whose null equalises means).
 - :func:`excess_theil`: Theil T above what equal shares give at the same
   totals. Theil T of a multinomial draw of F pellets among n agents with equal
   shares is about (n - 1) / (2F) for large F: a condition that eats less looks
@@ -38,7 +34,7 @@ import pandas as pd
 from scipy import stats as sps
 
 from ..analysis.inequality import theil_t
-from ..analysis.stats import STAT_COLUMNS, signed_rank_test, wilcoxon_paired
+from ..analysis.stats import STAT_COLUMNS, wilcoxon_paired
 from .verdicts import NAN_CI
 
 
@@ -175,99 +171,22 @@ def paired_vs_control(summary: pd.DataFrame, measure: str, control: str, conditi
     return rows[[*STAT_COLUMNS, "p_raw", "measure"]]
 
 
-# ------------------------------------------------------------------ equivalence
-#: No equivalence margin is wider than this fraction of the control's typical value (rule 3): a margin as wide
-#: as the control itself would call an ablation that halves food "equivalent".
-MAX_MARGIN_RATIO = 0.5
-
-
-def typical_value(control: np.ndarray) -> float:
-    """The control's typical magnitude: |median|, or the mean |value| where the median is 0 (mostly-zero counts)."""
-    c = np.asarray(control, np.float64)
-    c = c[np.isfinite(c)]
-    med = abs(float(np.median(c))) if c.size else 0.0
-    return med if med > 0 else float(np.mean(np.abs(c))) if c.size else 0.0
-
-
-def equivalence_margin(control: np.ndarray, sd: float, fraction: float, sd_fraction: float) -> tuple[float, float, str]:
-    """The equivalence margin of an "n.s." part, its ratio to the control's typical value, and how it was chosen.
-
-    ``fraction`` of the control's median, unless that median is near 0 (within
-    one ``sd`` of it, where a relative margin shrinks to nothing): then
-    ``sd_fraction`` x ``sd`` (the SD of the paired differences for a paired
-    test, the pooled SD otherwise). Never wider than :data:`MAX_MARGIN_RATIO`
-    of the control's :func:`typical_value`. ValueError when no positive margin
-    results (a control that is 0 throughout).
-
-    >>> m, r, _ = equivalence_margin(np.array([10.0, 12, 14]), 20.0, 0.2, 0.5); round(m, 3), round(r, 3)
-    (6.0, 0.5)
-    """
-    c = np.asarray(control, np.float64)
-    c = c[np.isfinite(c)]
-    if c.size == 0:
-        raise ValueError("no finite control value for an equivalence margin")
-    med, typical = float(np.median(c)), typical_value(c)
-    if typical <= 0:
-        raise ValueError("the control is 0 in every episode: no equivalence margin")
-    if abs(med) > sd and fraction * abs(med) > 0:
-        margin, how = fraction * abs(med), f"{fraction:g} x control median {med:.3g}"
-    else:
-        margin, how = sd_fraction * sd, f"{sd_fraction:g} SD ({sd:.3g}; control median {med:.3g} near 0)"
-    if margin > MAX_MARGIN_RATIO * typical or margin <= 0:
-        margin, how = MAX_MARGIN_RATIO * typical, f"{MAX_MARGIN_RATIO:g} x the control's typical value {typical:.3g}"
-    return margin, margin / typical, how
-
-
-def pooled_sd(a: np.ndarray, b: np.ndarray) -> float:
-    """Pooled standard deviation of two samples (NaN-free), 0 when neither varies."""
-    a, b = (np.asarray(x, np.float64) for x in (a, b))
-    dof = max(len(a) + len(b) - 2, 1)
-    return float(np.sqrt((np.sum((a - a.mean()) ** 2) + np.sum((b - b.mean()) ** 2)) / dof))
-
-
-def tost_paired(diff: np.ndarray, margin: float) -> float:
-    """TOST p that the median paired difference lies within (-margin, margin): Wilcoxon signed-rank tests of
-    diff + margin > 0 and diff - margin < 0; the larger of the two one-sided p's."""
-    d = np.asarray(diff, np.float64)
-    d = d[np.isfinite(d)]
-    if d.size < 2:
-        raise ValueError(f"fewer than 2 paired differences for an equivalence test ({d.size})")
-    lower = signed_rank_test(d + margin, "greater")[1] if np.any(d + margin) else 1.0
-    upper = signed_rank_test(d - margin, "less")[1] if np.any(d - margin) else 1.0
-    return float(max(lower, upper))
-
-
-def tost_unpaired(x: np.ndarray, control: np.ndarray, margin: float) -> float:
-    """TOST p that ``x`` and ``control`` differ by less than ``margin`` in location: Mann-Whitney tests of
-    x + margin > control and x - margin < control; the larger one-sided p."""
-    x, c = (np.asarray(v, np.float64) for v in (x, control))
-    x, c = x[np.isfinite(x)], c[np.isfinite(c)]
-    if x.size < 2 or c.size < 2:
-        raise ValueError(f"fewer than 2 values per group for an equivalence test ({x.size}, {c.size})")
-    lower = sps.mannwhitneyu(x + margin, c, alternative="greater").pvalue
-    upper = sps.mannwhitneyu(x - margin, c, alternative="less").pvalue
-    return float(max(lower, upper))
-
-
-def welch_tost(x: np.ndarray, control: np.ndarray, margin: float,
-               alpha: float = 0.05) -> tuple[float, float, float, tuple[float, float]]:
-    """Difference of means (x minus control), its two-sided Welch p, the Welch TOST p within ``margin``, and the
-    1 - ``alpha`` Welch interval of the difference (the one that inverts the two-sided test).
+def welch_difference(x: np.ndarray, control: np.ndarray, level: float) -> tuple[float, float, tuple[float, float]]:
+    """Difference of means (x minus control), its two-sided Welch p, and the Welch interval at ``level`` (the one
+    that inverts the test at 1 - ``level``).
 
     For a quantity defined against an expectation (the excess Theil T is the
     observed minus the null's mean), the means are what the null equalises, so
-    the t-tests are the matching tests; a rank test would also pick up the
-    null's skew, which differs with the total.
+    the t-test is the matching test; a rank test would also pick up the null's
+    skew, which differs with the total.
     """
     x, c = (np.asarray(v, np.float64) for v in (x, control))
     x, c = x[np.isfinite(x)], c[np.isfinite(c)]
     if x.size < 2 or c.size < 2:
         raise ValueError(f"fewer than 2 values per group for a t-test ({x.size}, {c.size})")
     test = sps.ttest_ind(x, c, equal_var=False)
-    ci = test.confidence_interval(1 - alpha)
-    lower = sps.ttest_ind(x + margin, c, equal_var=False, alternative="greater").pvalue
-    upper = sps.ttest_ind(x - margin, c, equal_var=False, alternative="less").pvalue
-    return float(x.mean() - c.mean()), float(test.pvalue), float(max(lower, upper)), (float(ci.low), float(ci.high))
+    ci = test.confidence_interval(level)
+    return float(x.mean() - c.mean()), float(test.pvalue), (float(ci.low), float(ci.high))
 
 
 # ------------------------------------------------------------------ inequality

@@ -2,7 +2,7 @@
 (``claims_by_stage_fig2`` .. ``_fig6``, the groups of :data:`efish.claims.registry.CLAIM_FIGURES`), one small axes
 per claim part, three to a row so that a figure stays legible at a page's width.
 
-Each axes shows a part's effect with its 95% interval at every kept training
+Each axes shows a part's effect with its interval (the one its verdict reads) at every kept training
 stage against env steps (log axis), points coloured by that stage's verdict, a
 line at 0 and the paper's side of it shaded; the y label names that side
 ("effect (paper: > 0)"; "paper: 0", a part the paper reports as no
@@ -31,9 +31,10 @@ from ..claims.stages import TRENDS, stage_trends
 from .render import save_figure
 from .style import NEUTRAL_COLOUR, missing, panel_style, tint
 
-#: A verdict's colour in this figure (green holds, amber weaker, vermilion fails, greys for the rest).
-VERDICT_COLOURS = {"holds": "#009E73", "weaker": "#E69F00", "fails": "#D55E00", "not decidable": NEUTRAL_COLOUR,
-                   "not run": tint(NEUTRAL_COLOUR, 0.5)}
+#: A verdict's colour in this figure and the claims grid (Okabe-Ito: green holds, blue absent, vermilion opposite,
+#: amber inconclusive, greys for the rest), one per :data:`efish.claims.verdicts.VERDICTS`.
+VERDICT_COLOURS = {"holds": "#009E73", "absent": "#0072B2", "opposite": "#D55E00", "inconclusive": "#E69F00",
+                   "not decidable": NEUTRAL_COLOUR, "not run": tint(NEUTRAL_COLOUR, 0.5)}
 #: Side of one part's axes, inches; at most this many axes per row. Three columns of 2.4 in at :data:`FONT` pt read
 #: at about 11 px per 8 pt on a documentation page 730 px wide (four columns of the whole table, at 7 pt, did not).
 AXES_IN, COLUMNS = (2.4, 2.0), 3
