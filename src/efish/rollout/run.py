@@ -143,8 +143,9 @@ def episode_table(steps: pd.DataFrame, bites_received: np.ndarray) -> pd.DataFra
 class FoodLog:
     """One record per pellet that ever existed: where, when it appeared, when it was eaten (-1: never).
 
-    Pellet slots are reused by regrowth, so records follow slots, not the reverse.
-    A pellet that regrows and is eaten within the same step is not seen (one-patch only).
+    Pellet slots are reused by regrowth, so records follow slots, not the reverse. A pellet that regrows and is
+    eaten within the same step (regrowth comes first in a step: one-patch arenas) gets a record of its own,
+    spawned and eaten at that step.
     """
 
     def __init__(self, env: VecEnv):
@@ -168,7 +169,10 @@ class FoodLog:
         alive = alive | ~running[:, None]
         for b, i in zip(*np.nonzero(eaten_slot >= 0), strict=True):
             if running[b]:
-                record = self.records[self.slot[b, eaten_slot[b, i]]]
+                k = eaten_slot[b, i]
+                if not alive_before[b, k]:  # regrown and eaten in this step: no record holds it yet
+                    self._spawn(env, b, k, t)
+                record = self.records[self.slot[b, k]]
                 record[5], record[6] = t, i
         for b, k in zip(*np.nonzero(~alive_before & alive), strict=True):
             self._spawn(env, b, k, t)
