@@ -199,12 +199,6 @@ class Stages:
         own = [str(run.path(CLAIM_PARTS))] if self.last_is_final else []
         return [str(run.stage(k).path(CLAIM_PARTS)) for k in self.rerun] + own
 
-    def training_targets(self, run: Run) -> list[str]:
-        """Every policy the run trains: each seed's final.pt and that of each recipe the scale's assays act with (in
-        ``rule all``: a sweep's point that copies its training gets all of it, as if it had trained)."""
-        recipes = sorted({p for name in self.assays for p in self.assay_policies[name]} - {SELECTED})
-        return [str(run.path(training_file(name, "final.pt"))) for name in [*map(seed_name, self.seeds), *recipes]]
-
     def targets(self, run: Run) -> list[str]:
         """The ``learning`` target: the claims along training. Without kept stages a :class:`PlanError` (the
         target would otherwise train and assay for nothing before failing)."""
