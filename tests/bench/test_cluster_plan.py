@@ -161,3 +161,19 @@ def test_efish_plan_cluster_prints_the_plan_and_names_missing_benchmarks(tmp_pat
     assert "runtime_headroom" in out and "set-resources:" in out
     assert main([*args, "--results", str(tmp_path / "none")]) == 2
     assert capsys.readouterr().err.startswith("efish: error: no Snakemake benchmark files under")
+
+
+def test_a_top_seed_group_scales_with_its_seeds_and_its_links_are_taken_as_measured():
+    """One grouped job rolls out every top seed that reruns the assay: its work is the assay's agent-steps times
+    the group's seeds (all top seeds for the supplement's assays, the others for a claim's); the per-seed jobs
+    that only link the group's tables do not scale."""
+    from efish.bench.cluster import Job
+
+    model = CostModel(["scale=laptop"])
+    scale = model._cfg().scale
+    supplement, claim = scale.top_seed_assays[0], "ablation4"
+    assert claim not in scale.top_seed_assays
+    for assay, seeds in ((supplement, scale.top_seeds), (claim, scale.top_seeds - 1)):
+        work, memory = model.units(Job("top_seed_group", {"run": "laptop", "assay": assay}, None))
+        assert work == memory == pytest.approx(model._assay_steps(assay) * seeds)
+    assert model.units(Job("top_seed_assay", {"run": "laptop", "seed": "2", "assay": claim}, None)) is None

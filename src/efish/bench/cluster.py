@@ -145,13 +145,22 @@ class CostModel:
         if rule == "train_policy":
             return self._training(f"policy={wc['policy']}")
         assay = "selection" if rule == "evaluate_seed" else wc.get("assay")
-        # the top seeds' assays and analyses are the same work as the selected seed's
-        if assay and (rule in ("evaluate_seed", "assay", "assay_with_hidden", "top_seed_assay",
-                               "top_seed_assay_with_hidden")
+        if assay and rule == "top_seed_group":  # one job rolls out every top seed that reruns the assay
+            steps = self._assay_steps(assay) * self._group_size(assay)
+            return steps, steps
+        # the top seeds' analyses are the same work as the selected seed's; their top_seed_assay jobs only link
+        # the group's tables (taken as measured)
+        if assay and (rule in ("evaluate_seed", "assay", "assay_with_hidden")
                       or rule.startswith(("analysis_", "top_seed_analysis_"))):
             steps = self._assay_steps(assay)
             return steps, steps
         return None
+
+    def _group_size(self, assay: str) -> int:
+        """The seeds in an assay's top-seed group (efish.run_plan.RunPlan.group_seeds): every top seed for the
+        supplement's assays, the others for a claim's assay."""
+        scale = self._cfg().scale
+        return max(1, scale.top_seeds if assay in scale.top_seed_assays else scale.top_seeds - 1)
 
 
 def plan_jobs(jobs: list[Job], measured: pd.DataFrame, source: CostModel, target: CostModel) -> pd.DataFrame:
