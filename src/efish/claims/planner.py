@@ -1,4 +1,4 @@
-"""What a decisive recipe verdict would cost, part by part, from a finished run's own tables (issue: the planner).
+"""What a decisive recipe verdict would cost, part by part, from a finished run's own tables.
 
 For every part the recipe decides over seeds, the run's seeds give its variance components
 (:func:`efish.claims.power.components`: the seeds' effects and their own standard errors, read back from their
