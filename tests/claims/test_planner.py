@@ -9,6 +9,7 @@ from scipy import stats
 
 from efish.claims.planner import PLAN_COLUMNS, RunCosts, plan_parts, run_costs
 from efish.claims.power import decision_probabilities
+from efish.layout import Run
 
 ALPHA = 0.05
 
@@ -64,15 +65,15 @@ def benchmark(path, cpu_time: float, wall: float = 1.0) -> None:
 
 
 def test_run_costs_reads_the_runs_own_benchmarks(tmp_path):
-    root = tmp_path / "benchmarks"
+    run = Run("r", results_root=tmp_path)
     for seed, cpu in ((1, 300.0), (2, 500.0)):
-        benchmark(root / "train" / f"seed_{seed}.tsv", cpu)
-        benchmark(root / "selection" / f"seed_{seed}.tsv", 10.0)
-    benchmark(root / "seeds" / "seed_2" / "assays" / "patchy4.tsv", 60.0)
-    benchmark(root / "seeds" / "seed_2" / "claims.tsv", 20.0)
-    benchmark(root / "seeds" / "patchy4.tsv", 999.0)  # the stacked table of all top seeds: not a seed's rerun
-    costs = run_costs(tmp_path, [1, 2], other_top_seeds=1)
+        benchmark(run.benchmark(f"train/seed_{seed}"), cpu)
+        benchmark(run.benchmark(f"selection/seed_{seed}"), 10.0)
+    benchmark(run.top_seed(2).benchmark("assays/patchy4"), 60.0)
+    benchmark(run.top_seed(2).benchmark("claims"), 20.0)
+    benchmark(run.benchmark("seeds/patchy4"), 999.0)  # the stacked table of all top seeds: not a seed's rerun
+    costs = run_costs(run, [1, 2], other_top_seeds=1)
     assert (costs.train_s, costs.selection_s, costs.rerun_s) == (400.0, 10.0, 80.0)
     assert costs.design_hours(9) == pytest.approx(9 * 490 / 3600) and np.isnan(costs.design_hours(None))
     with pytest.raises(ValueError, match="no training benchmarks"):
-        run_costs(tmp_path / "empty", [1], 0)
+        run_costs(Run("empty", results_root=tmp_path), [1], 0)

@@ -20,7 +20,7 @@ from typing import NamedTuple
 import numpy as np
 import pandas as pd
 
-from ..layout import BENCHMARKS, seed_name
+from ..layout import Run, seed_name, selection_table, top_seed_copy, training_folder
 from .power import MAX_SEEDS, SCENARIOS, TARGET, components, decision_probabilities, scenario_verdict, seeds_needed
 from .power import standard_error as interval_se
 
@@ -56,23 +56,21 @@ def _cpu_seconds(path: Path) -> float:
     return float(value) if pd.notna(value) and float(value) > 0 else float(row["s"])
 
 
-def run_costs(results: str | Path, seeds: Sequence[int], other_top_seeds: int) -> RunCosts:
-    """The run's measured cost of a seed, from ``results/<run>/benchmarks/``: the mean CPU time of the ``seeds``'
-    training and selection jobs, and of everything the top seeds' reruns ran (every file under
-    ``benchmarks/seeds/`` in a folder of its own, however the workflow grouped them) over ``other_top_seeds``.
-    One clear error when a run has no training benchmarks."""
-    root = Path(results) / BENCHMARKS
-    train = [root / "train" / f"{seed_name(s)}.tsv" for s in seeds]
-    train = [p for p in train if p.exists()]
+def run_costs(run: Run, seeds: Sequence[int], other_top_seeds: int) -> RunCosts:
+    """The run's measured cost of a seed, from its Snakemake benchmark files (:meth:`efish.layout.Run.benchmark`):
+    the mean CPU time of the ``seeds``' training and selection jobs, and of everything the top seeds' reruns ran
+    (every file in a folder of its own under the top seeds' benchmarks, however the workflow grouped them) over
+    ``other_top_seeds``. One clear error when a run has no training benchmarks."""
+    train = [p for s in seeds if (p := run.benchmark(training_folder(seed_name(s)))).exists()]
     if not train:
-        raise ValueError(f"no training benchmarks under {root / 'train'}: the planner prices a design with the "
+        raise ValueError(f"no training benchmarks under {run.benchmarks}: the planner prices a design with the "
                          "run's own job times (run the pipeline first)")
-    selection = [p for s in seeds if (p := root / "selection" / f"{seed_name(s)}.tsv").exists()]
-    reruns = [p for p in (root / "seeds").glob("*/**/*.tsv")] if (root / "seeds").is_dir() else []
-    rerun_s = sum(map(_cpu_seconds, reruns)) / other_top_seeds if other_top_seeds and reruns else np.nan
+    selection = [p for s in seeds if (p := run.benchmark(str(Path(selection_table(s, "x")).parent))).exists()]
+    top_seeds = run.benchmarks / Path(top_seed_copy(0)).parent  # each seed's or group's jobs in a folder of its own
+    reruns = list(top_seeds.glob("*/**/*.tsv")) if top_seeds.is_dir() else []
+    rerun_s = sum(map(_cpu_seconds, reruns)) / other_top_seeds if other_top_seeds and reruns else 0.0
     return RunCosts(float(np.mean([_cpu_seconds(p) for p in train])),
-                    float(np.mean([_cpu_seconds(p) for p in selection])) if selection else 0.0,
-                    float(rerun_s) if np.isfinite(rerun_s) else 0.0,
+                    float(np.mean([_cpu_seconds(p) for p in selection])) if selection else 0.0, float(rerun_s),
                     f"training {len(train)}, selection {len(selection)}, reruns of {other_top_seeds} seeds")
 
 
