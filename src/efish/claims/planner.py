@@ -23,10 +23,11 @@ import pandas as pd
 from ..layout import Run, seed_name, selection_table, top_seed_copy, training_folder
 from .power import MAX_SEEDS, SCENARIOS, TARGET, components, decision_probabilities, scenario_verdict, seeds_needed
 from .power import standard_error as interval_se
+from .recipe import FISHER_Z, fisher_z
+from .verdicts import interval_level
 
 __all__ = ["PLAN_COLUMNS", "RunCosts", "plan_parts", "run_costs"]
 
-FISHER_Z = "Fisher-z"  # as efish.claims.recipe marks a correlation's interval: planned on the z scale
 #: One row per part: the run's design (seeds, mean units per seed), the variance components, the chance of each
 #: scenario's verdict now and the seeds (and CPU-hours) that reach :data:`~efish.claims.power.TARGET`.
 PLAN_COLUMNS = ["claim", "part", "sign", "delta", "seeds", "units", "effect", "tau", "sigma",
@@ -79,9 +80,9 @@ def _seed_values(rows: pd.DataFrame, alpha: float, correlation: bool) -> tuple[n
     the scale the recipe decides on (Fisher's z for a correlation)."""
     effect, low, high = (rows[c].astype(float).to_numpy() for c in ("effect", "ci_low", "ci_high"))
     if correlation:
-        effect, low, high = (np.arctanh(np.clip(v, -0.999, 0.999)) for v in (effect, low, high))
-    levels = 1 - 2 * alpha / rows["family"].astype(float).to_numpy()
-    ses = np.array([interval_se(lo, hi, level) for lo, hi, level in zip(low, high, levels, strict=True)])
+        effect, low, high = (fisher_z(v) for v in (effect, low, high))
+    ses = np.array([interval_se(lo, hi, interval_level(alpha, int(f)))
+                    for lo, hi, f in zip(low, high, rows["family"], strict=True)])
     return effect, ses, rows["n"].astype(float).to_numpy()
 
 
@@ -109,7 +110,7 @@ def plan_part(rows: pd.DataFrame, alpha: float, costs: RunCosts) -> dict:
     else:  # no usable interval (unbounded rank intervals): all the spread counted as between seeds
         comp = components(effect, np.zeros_like(effect), units)
         notes.append("seeds' intervals unbounded: all spread counted as between seeds")
-    planned_delta = float(np.arctanh(min(delta, 0.999))) if correlation else delta
+    planned_delta = float(fisher_z(delta)) if correlation else delta
     if not comp.seed_sd() > 0:
         return out | {"delta": delta, "units": comp.units, "effect": comp.effect, "tau": comp.tau,
                       "sigma": comp.sigma, "note": "every seed gave the same effect: no spread to plan from"}

@@ -173,8 +173,3 @@ def seeds_needed(components_: Components, sign: int | None, delta: float, alpha:
         lo, hi = (lo, mid) if chance(mid) >= target else (mid, hi)
     return hi
 
-
-def design_seconds(seeds: int, episodes: float, seed_seconds: float, episode_seconds: float) -> float:
-    """The compute a design costs: each seed trained (``seed_seconds``) and run over ``episodes`` episodes of the
-    claims' assays (``episode_seconds`` per episode of all of them together)."""
-    return seeds * (seed_seconds + episodes * episode_seconds)

@@ -70,6 +70,12 @@ RECIPE_COLUMNS = ["recipe_verdict", "recipe_parts", "recipe_effect", "recipe_ci_
 FISHER_Z = "Fisher-z"  # a part whose interval inverts Fisher's z is a correlation: combined on the z scale
 
 
+def fisher_z(r):
+    """Fisher's z of correlations (arrays or floats), a seed at |rho| = 1 kept finite (clipped to 0.999)."""
+    return np.arctanh(np.clip(r, -0.999, 0.999))
+
+
+
 class Pooled(NamedTuple):
     """A part over the seeds (:func:`pooled`): the decision of the seeds' effects (mean, interval, verdict,
     p of "beyond delta the other way"), the t-test p of their mean against 0, and ``tau``, their SD."""
@@ -93,7 +99,7 @@ def pooled(effects, sign: int | None, delta: float, alpha: float, family: int = 
     if y.size < MIN_SEEDS or not np.isfinite(y).all():
         raise ValueError(f"a t interval over seeds needs {MIN_SEEDS} finite effects, got {y.tolist()}")
     if correlation:  # a seed at |rho| = 1 stays finite on the z scale
-        y, delta = np.arctanh(np.clip(y, -0.999, 0.999)), float(np.arctanh(min(delta, 0.999)))
+        y, delta = fisher_z(y), float(fisher_z(delta))
     found = over_seeds(y, sign, delta, alpha, family)
     se = float(y.std(ddof=1)) / np.sqrt(y.size)
     if se > 0:
