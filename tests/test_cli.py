@@ -271,7 +271,7 @@ def test_every_command_has_a_handler_and_the_docstring_lists_it():
     import efish.cli as cli
 
     commands = _commands(cli._parser())
-    assert len(commands) == 27 and "bench group" in commands and "bench scaling" in commands and "claims-by-stage" in commands and "compare-claims" in commands
+    assert len(commands) == 28 and "bench group" in commands and "bench scaling" in commands and "claims-by-stage" in commands and "compare-claims" in commands
     assert "watch" in commands
     for name, parser in commands.items():
         assert callable(parser.get_default("handler")), name

@@ -31,6 +31,10 @@
                                               of claims, fig2 .. fig6 (--figures, default figures/<run>/learning)
     efish compare-claims A B                  two runs' claim verdicts, seeds_agree and effects side by side
     efish compare-claims A B C --heatmap H.png  claims x runs: a table (--out) and a heatmap
+    efish power [overrides] [--results D] [--out D] [--figures D]
+                                              what a decisive verdict costs: each part planned over the top seeds,
+                                              priced with the run's job times -> power.parquet, power_curves.parquet,
+                                              power.md (default results/<run>/claims), power.png|pdf (--figures)
     efish scene NAME [overrides] --out D      field maps of config/scene/NAME.yaml -> D/NAME.parquet
     efish bench physics [overrides] [--json] [--out D]   sensing throughput, fast vs reference
     efish bench accuracy [overrides] [--out D] [--figures D]   accuracy-vs-time study -> table (--out, default
@@ -73,7 +77,7 @@ from pathlib import Path
 from typing import Sequence
 
 from ._version import __version__
-from .cli_claims import run_claims, run_claims_by_stage, run_compare_claims
+from .cli_claims import run_claims, run_claims_by_stage, run_compare_claims, run_power
 from .cli_support import HelpFormatter, add_command, add_overrides, run_of, see_docs, write_metadata
 from .config import ConfigError, compose, to_yaml
 from .figures.gallery import GALLERY, MAX_WIDTH_PX
@@ -84,6 +88,8 @@ from .layout import (
     CLAIMS_BY_STAGE_FIGURE,
     CONTACT_SHEET,
     FIGURES_ROOT,
+    POWER_FIGURE,
+    POWER_TABLE,
     RANKING,
     RESULTS_ROOT,
     SELECTED_SEED,
@@ -318,6 +324,24 @@ def _claims_commands(sub: argparse._SubParsersAction) -> None:
     cl.set_defaults(handler=run_claims)
     _claims_by_stage_command(sub)
     _compare_claims_command(sub)
+    _power_command(sub)
+
+
+def _power_command(sub: argparse._SubParsersAction) -> None:
+    """``efish power``: what a decisive verdict costs, from a finished run."""
+    pw = add_command(sub, "power", "what a decisive verdict would cost: seeds and CPU-hours per claim part",
+                     "Plan each claim part over the run's top seeds: split its effect's spread into between seeds and "
+                     "within a seed, give the chance that the recipe's verdict settles (holds if the effect is twice "
+                     "delta, absent if there is none) now and the seeds, priced in CPU-hours with the run's own job "
+                     "times, that reach 80%. Writes power.parquet, power_curves.parquet and power.md (--out) and "
+                     "power.png and .pdf (--figures). Nothing here changes a verdict.", "docs/claims/power.md")
+    add_overrides(pw, example="scale=laptop", note="they name the run and its alpha")
+    pw.add_argument("--results", type=Path, help="the run's results folder (default results/{run})")
+    _add_out(pw, f"folder for power.parquet, power_curves.parquet and power.md (default "
+                 f"results/{{run}}/{Path(POWER_TABLE).parent})")
+    pw.add_argument("--figures", type=Path, help=f"folder for power.png and .pdf (default "
+                                                 f"figures/{{run}}/{Path(POWER_FIGURE).parent})")
+    pw.set_defaults(handler=run_power)
 
 
 def _claims_by_stage_command(sub: argparse._SubParsersAction) -> None:

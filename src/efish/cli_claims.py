@@ -1,6 +1,6 @@
 """The claims commands of ``efish``: ``claims`` (a run's verdicts, with the other top seeds' and the trends along
-training), ``claims-by-stage`` (the claims at the kept training stages) and ``compare-claims`` (two runs side by
-side). Their parsers are in :mod:`efish.cli`."""
+training), ``claims-by-stage`` (the claims at the kept training stages), ``compare-claims`` (two runs side by
+side) and ``power`` (what a decisive verdict would cost). Their parsers are in :mod:`efish.cli`."""
 
 from __future__ import annotations
 
@@ -16,6 +16,10 @@ from .layout import (
     CLAIMS_TABLE,
     CLAIMS_TRENDS,
     CLAIMS_TRENDS_PAGE,
+    POWER_CURVES,
+    POWER_FIGURE,
+    POWER_PAGE,
+    POWER_TABLE,
     RANKING,
     RECIPE_PARTS,
 )
@@ -58,6 +62,43 @@ def run_claims(args, cfg, started) -> None:
     print(table[shown + ["seeds_agree"] * ("seeds_agree" in table.columns)].to_string(
         index=False, float_format=lambda v: f"{v:.3g}"))
     print(f"wrote {table_path}, {', '.join(str(out / f'{name}.parquet') for name in written)} and {page_path}")
+
+
+def run_power(args, cfg, started) -> None:
+    """``efish power``: the planner's table, its curves, page and figure for a finished run
+    (:mod:`efish.claims.planner`)."""
+    from .bench.timing import machine, machine_line
+    from .claims.planner import part_models, plan_table, power_curves, read_run
+    from .claims.power_page import headline, power_markdown
+    from .figures.power import plot_power
+    from .io import write_parquet_tables, write_text_atomic
+    from .layout import Run
+
+    run = run_of(cfg, args.overrides)
+    if args.results is not None:
+        run = Run(args.results.name, results_root=args.results.parent)
+    alpha = cfg.analysis.claims_alpha
+    tables, costs = read_run(run, alpha)  # everything read (and checked) before anything is written
+    out = args.out or run.path(POWER_TABLE).parent
+    figures = args.figures or (run.figures / POWER_FIGURE).parent
+    models = part_models(tables, alpha)
+    plan = plan_table(models, alpha, costs)
+    curves = power_curves(models, alpha, costs)
+    seeds = ", ".join(map(str, tables))
+    header = (f"Run {run.name} at scale {cfg.scale.name}, seeds {seeds} (the selected seed first), "
+              f"{started.strftime('%Y-%m-%d %H:%M UTC')}; {machine_line(machine())}.")
+    written = write_parquet_tables({Path(POWER_TABLE).stem: plan, Path(POWER_CURVES).stem: curves}, out)
+    page = out / Path(POWER_PAGE).name
+    write_text_atomic(page, power_markdown(plan, costs, header, alpha))
+    drawn = plot_power(curves, plan, figures / Path(POWER_FIGURE).name,
+                       f"What a decisive verdict costs: run {run.name}, seeds {seeds}")
+    write_metadata(out, cfg, started, args, name="power.provenance.json", results=str(run.results),
+                   seeds=list(tables), costs=costs._asdict())
+    shown = ["claim", "part", "seeds", "now_holds_at_2delta", "seeds_holds_at_2delta", "cpu_hours_holds_at_2delta",
+             "now_absent_at_0", "seeds_absent_at_0"]
+    print(plan[shown].to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+    print(headline(plan, costs))
+    print(f"wrote {', '.join(map(str, [*written, page, *drawn]))}")
 
 
 def _seed_claims(args, results: Path):

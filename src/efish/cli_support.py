@@ -47,6 +47,7 @@ DOC_PAGES: dict[str, str] = {
     "docs/claims/index.md": "Claims › Rules and claims",
     "docs/claims/results.md": "Claims › Results",
     "docs/claims/along-training.md": "Claims › Along training",
+    "docs/claims/power.md": "Claims › What a verdict costs",
     "docs/benchmarks.md": "Benchmarks",
     "docs/reference/config.md": "Reference › Configuration",
     "docs/reference/tables.md": "Reference › Tables",

@@ -16,12 +16,14 @@ its tables under ``results/<run>/`` and its drawings under ``figures/<run>/``::
       learning/stage_K/               the same for the selected seed's K-th kept training stage
       learning/                       claims_by_stage, claims_trends .parquet, claims.md (claims along training)
       scenes/<scene>.parquet          field maps
-      claims/                         claims.parquet, claims.md
+      claims/                         claims, claim_parts, recipe_parts .parquet, claims.md; power, power_curves
+                                      .parquet, power.md (what a decisive verdict costs)
       bench/                          benchmark tables
       logs/, benchmarks/              one .log and one Snakemake .tsv per job
     figures/<run>/
       <figure>/<panel>.png|pdf, <figure>.png|pdf, clips/<assay>.gif, contact_sheet.png, bench/,
-      learning/claims_by_stage_<figure>.png|pdf (the claims along training, one per figure of claims)
+      learning/claims_by_stage_<figure>.png|pdf (the claims along training, one per figure of claims),
+      claims/power.png|pdf (what a decisive verdict costs)
 
 Panels and claims name a table by its path relative to ``results/<run>/`` (``assays/patchy4/steps.parquet``);
 the functions below build those names and :func:`parse_table` reads them back. :class:`Run` anchors them in a
@@ -253,6 +255,12 @@ class Run:
 # ------------------------------------------------ claims per part and along training (efish claims, claims-by-stage)
 CLAIM_PARTS = "claims/claim_parts.parquet"  # one row per part of each claim, beside claims.parquet
 RECIPE_PARTS = "claims/recipe_parts.parquet"  # each part decided over the top seeds (efish.claims.recipe)
+#: What a decisive verdict costs (``efish power``): the plan per part, the chance per part and design, the page,
+#: and the figure's stem under ``figures/<run>/``.
+POWER_TABLE = "claims/power.parquet"
+POWER_CURVES = "claims/power_curves.parquet"
+POWER_PAGE = "claims/power.md"
+POWER_FIGURE = "claims/power"
 #: The claims along training (``efish claims-by-stage``): the stages' parts stacked and each part's trend, under
 #: ``results/<run>/``, and their figures (``.png``, ``.pdf``) under ``figures/<run>/``.
 CLAIMS_BY_STAGE = f"{LEARNING}/claims_by_stage.parquet"

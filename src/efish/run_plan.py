@@ -44,6 +44,10 @@ from .layout import (
     CLAIMS_TRENDS,
     CLAIMS_TRENDS_PAGE,
     FIGURE_FORMATS,
+    POWER_CURVES,
+    POWER_FIGURE,
+    POWER_PAGE,
+    POWER_TABLE,
     ROLLOUT_TABLES,
     Run,
     analysis_table,
@@ -241,6 +245,13 @@ def learning_outputs(run: Run) -> dict[str, str]:
     figures = {f"{ext}_{group}": str(run.figures / f"{claims_by_stage_stem(group)}.{ext}")
                for group in CLAIM_FIGURES for ext in FIGURE_FORMATS}
     return {name: str(run.path(path)) for name, path in tables.items()} | figures
+
+
+def power_outputs(run: Run) -> dict[str, str]:
+    """What ``efish power`` writes for ``run``: the plan, its curves, its page and its figure (png, pdf)."""
+    tables = {"table": POWER_TABLE, "curves": POWER_CURVES, "page": POWER_PAGE}
+    figure = {ext: str(run.figures / f"{POWER_FIGURE}.{ext}") for ext in FIGURE_FORMATS}
+    return {name: str(run.path(path)) for name, path in tables.items()} | figure
 
 
 # ------------------------------------------------------------------ the plan
@@ -459,6 +470,7 @@ class RunPlan:
         targets += [path for figure in self.figure_panels for path in self.figure_outputs(figure, run)]
         targets += self.render_targets(run)
         targets += [str(run.path(name)) for name in (CLAIMS_TABLE, CLAIM_PARTS, CLAIMS_PAGE)]
+        targets += list(power_outputs(run).values())
         if scale.learning:
             targets += list(learning_outputs(run).values())
         return targets

@@ -7,9 +7,21 @@ import pandas as pd
 import pytest
 from scipy import stats
 
-from efish.claims.planner import PLAN_COLUMNS, RunCosts, plan_parts, run_costs
+from efish.claims.planner import (
+    CURVE_COLUMNS,
+    CURVE_SEEDS,
+    PLAN_COLUMNS,
+    RunCosts,
+    claim_curves,
+    part_models,
+    plan_parts,
+    plan_table,
+    power_curves,
+    run_costs,
+)
 from efish.claims.power import decision_probabilities
-from efish.layout import Run
+from efish.cli import main
+from efish.layout import CLAIM_PARTS, RANKING, Run
 
 ALPHA = 0.05
 
@@ -75,5 +87,76 @@ def test_run_costs_reads_the_runs_own_benchmarks(tmp_path):
     costs = run_costs(run, [1, 2], other_top_seeds=1)
     assert (costs.train_s, costs.selection_s, costs.rerun_s) == (400.0, 10.0, 80.0)
     assert costs.design_hours(9) == pytest.approx(9 * 490 / 3600) and np.isnan(costs.design_hours(None))
-    with pytest.raises(ValueError, match="no training benchmarks"):
-        run_costs(Run("empty", results_root=tmp_path), [1], 0)
+    unpriced = run_costs(Run("empty", results_root=tmp_path), [1], 0)  # e.g. a sweep's point that copied its training
+    assert np.isnan(unpriced.design_hours(3)) and "unpriced" in unpriced.seeds_timed
+
+
+def test_curves_rise_with_seeds_and_a_claim_reads_its_weakest_part():
+    rng = np.random.default_rng(6)
+    tables = {s: parts_table(rng, {"large": 0.5, "small": 0.15}, tau=0.05, sigma=0.2, n=8, delta=0.1)
+              for s in (3, 1, 4)}
+    models = part_models(tables, ALPHA)
+    curves = power_curves(models, ALPHA, COSTS, seeds=(2, 4, 8, 16))
+    assert list(curves.columns) == CURVE_COLUMNS and len(curves) == 2 * 4
+    for _, rows in curves.groupby("part"):
+        assert (np.diff(rows["holds_at_2delta"]) >= -1e-9).all()  # more seeds, never less power
+        assert rows["cpu_hours"].tolist() == pytest.approx([k * 600 / 3600 for k in (2, 4, 8, 16)])
+    claim = claim_curves(curves)
+    assert len(claim) == 4 and (claim["claim"] == "C9").all()
+    weakest = curves.groupby("seeds")["holds_at_2delta"].min().to_numpy()
+    assert claim["holds_at_2delta"].to_numpy() == pytest.approx(weakest)
+    # the curve's value at the run's seeds is the plan's "now"
+    plan = plan_table(models, ALPHA, COSTS).set_index("part")
+    at3 = power_curves(models, ALPHA, COSTS, seeds=(3,)).set_index("part")
+    assert at3["holds_at_2delta"].to_numpy() == pytest.approx(plan.loc[at3.index, "now_holds_at_2delta"].to_numpy())
+
+
+def write_run(root, effects: dict[int, float]) -> Run:
+    """A finished run's files as the planner reads them: the ranking, each top seed's claim_parts and the
+    benchmark files of its training and selection."""
+    run = Run("laptop", results_root=root)
+    rng = np.random.default_rng(7)
+    ranking = list(effects)
+    run.path(RANKING).parent.mkdir(parents=True)
+    pd.DataFrame({"seed": ranking}).to_parquet(run.path(RANKING))
+    for i, seed in enumerate(ranking):
+        where = run if i == 0 else run.top_seed(seed)
+        where.path(CLAIM_PARTS).parent.mkdir(parents=True)
+        parts_table(rng, {"p": effects[seed]}, 0.05, 0.2, 8, 0.1).to_parquet(where.path(CLAIM_PARTS))
+        benchmark(run.benchmark(f"train/seed_{seed}"), 400.0)
+        benchmark(run.benchmark(f"selection/seed_{seed}"), 20.0)
+    return run
+
+
+def test_power_command_writes_its_tables_page_and_figure(tmp_path, capsys):
+    run = write_run(tmp_path / "results", {2: 0.3, 5: 0.25, 1: 0.35})
+    out, figures = tmp_path / "power", tmp_path / "figures"
+    assert main(["power", "scale=laptop", "--results", str(run.results), "--out", str(out),
+                 "--figures", str(figures)]) == 0
+    plan = pd.read_parquet(out / "power.parquet")
+    assert list(plan.columns) == PLAN_COLUMNS and plan["seeds"].tolist() == [3]
+    assert list(pd.read_parquet(out / "power_curves.parquet").columns) == CURVE_COLUMNS
+    page = (out / "power.md").read_text()
+    assert "| C9 | p |" in page and "1 of 1 parts planned" in page and "0.117 CPU-hours" in page  # 420 s a seed
+    assert (figures / "power.png").stat().st_size > 0 and (figures / "power.pdf").exists()
+    assert "parts reach 80%" in capsys.readouterr().out
+
+
+def test_power_command_without_claims_is_one_line_and_writes_nothing(tmp_path, capsys):
+    out = tmp_path / "power"
+    assert main(["power", "scale=laptop", "--results", str(tmp_path / "nothing"), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "no seed ranking" in err and not out.exists()
+
+
+def test_a_run_without_training_benchmarks_is_planned_in_seeds_not_priced(tmp_path):
+    run = write_run(tmp_path / "results", {2: 0.3, 5: 0.25, 1: 0.35})
+    for tsv in run.benchmarks.rglob("*.tsv"):
+        tsv.unlink()  # as in a sweep's point that copied its training from another point
+    out = tmp_path / "power"
+    assert main(["power", "scale=laptop", "--results", str(run.results), "--out", str(out),
+                 "--figures", str(tmp_path / "figures")]) == 0
+    plan = pd.read_parquet(out / "power.parquet")
+    assert plan["seeds_holds_at_2delta"].notna().all() and plan["cpu_hours_holds_at_2delta"].isna().all()
+    assert "not priced" in (out / "power.md").read_text()
+    assert len(claim_curves(pd.read_parquet(out / "power_curves.parquet"))) == len(CURVE_SEEDS)

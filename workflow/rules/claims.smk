@@ -49,3 +49,28 @@ use rule claims as top_seed_claims with:
         results=folder_of("table", 1),
         seeds="",
         out=folder_of("table"),
+
+
+# What a decisive verdict costs (efish power, efish.claims.planner): each part planned over the top seeds' claim_parts
+# and priced with this run's benchmark files, which every job before it has written. No verdict reads it.
+rule power:
+    input:
+        parts=results(CLAIM_PARTS),
+        recipe=results(RECIPE_PARTS),
+        ranking=results(RANKING),
+        seed_parts=other_seed_parts,
+    output:
+        **power_outputs(),
+    log:
+        log("power"),
+    benchmark:
+        benchmark("power")
+    params:
+        overrides=ARGS,
+        results=folder_of("table", 1),
+        out=folder_of("table"),
+        figures=folder_of("png"),
+    conda:
+        "../envs/efish.yaml"
+    shell:
+        efish("power", "--results {params.results} --out {params.out} --figures {params.figures}")

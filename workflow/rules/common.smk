@@ -292,6 +292,14 @@ def learning_outputs(reported=False):
     return outputs
 
 
+def power_outputs():
+    """What efish power writes (efish.run_plan.power_outputs); its figure's PNG goes into the report, beside the
+    claims."""
+    outputs = run_plan.power_outputs(RULE_RUN)
+    outputs["png"] = report(outputs["png"], caption="../report/power.rst", category="Claims")
+    return outputs
+
+
 # ------------------------------------------------------------------ figures
 def report_entry(figure, path):
     """A figure job's output as the report shows it: each panel's PNG under its figure's category with the

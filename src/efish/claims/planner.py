@@ -20,13 +20,30 @@ from typing import NamedTuple
 import numpy as np
 import pandas as pd
 
-from ..layout import Run, seed_name, selection_table, top_seed_copy, training_folder
-from .power import MAX_SEEDS, SCENARIOS, TARGET, components, decision_probabilities, scenario_verdict, seeds_needed
+from ..layout import CLAIM_PARTS, RANKING, Run, seed_name, selection_table, top_seed_copy, training_folder
+from .power import (
+    MAX_SEEDS,
+    SCENARIOS,
+    TARGET,
+    Components,
+    components,
+    decision_probabilities,
+    scenario_verdict,
+    seeds_needed,
+)
 from .power import standard_error as interval_se
 from .recipe import FISHER_Z, fisher_z
 from .verdicts import interval_level
 
-__all__ = ["PLAN_COLUMNS", "RunCosts", "plan_parts", "run_costs"]
+__all__ = ["CURVE_COLUMNS", "PLAN_COLUMNS", "PartModel", "RunCosts", "claim_curves", "part_models", "plan_parts",
+           "plan_table", "power_curves", "read_run", "run_costs"]
+
+#: The column suffix of each of :data:`~efish.claims.power.SCENARIOS`, in its order.
+SCENARIO_KEYS = ("holds_at_2delta", "absent_at_0")
+#: The designs the figure draws: seeds at the run's episodes.
+CURVE_SEEDS = (2, 3, 4, 5, 6, 8, 10, 12, 16, 20, 24, 32, 40)
+#: One row per plannable part and design: the chance of each scenario's verdict and the design's CPU-hours.
+CURVE_COLUMNS = ["claim", "part", "seeds", "cpu_hours", *SCENARIO_KEYS]
 
 #: One row per part: the run's design (seeds, mean units per seed), the variance components, the chance of each
 #: scenario's verdict now and the seeds (and CPU-hours) that reach :data:`~efish.claims.power.TARGET`.
@@ -61,11 +78,10 @@ def run_costs(run: Run, seeds: Sequence[int], other_top_seeds: int) -> RunCosts:
     """The run's measured cost of a seed, from its Snakemake benchmark files (:meth:`efish.layout.Run.benchmark`):
     the mean CPU time of the ``seeds``' training and selection jobs, and of everything the top seeds' reruns ran
     (every file in a folder of its own under the top seeds' benchmarks, however the workflow grouped them) over
-    ``other_top_seeds``. One clear error when a run has no training benchmarks."""
+    ``other_top_seeds``. A run without training benchmarks gets NaN costs (its designs are planned, not priced)."""
     train = [p for s in seeds if (p := run.benchmark(training_folder(seed_name(s)))).exists()]
-    if not train:
-        raise ValueError(f"no training benchmarks under {run.benchmarks}: the planner prices a design with the "
-                         "run's own job times (run the pipeline first)")
+    if not train:  # a run whose training is another's (a sweep's point that copies it) or was not run by Snakemake
+        return RunCosts(np.nan, np.nan, np.nan, f"no training benchmark under {run.benchmarks}: designs unpriced")
     selection = [p for s in seeds if (p := run.benchmark(str(Path(selection_table(s, "x")).parent))).exists()]
     top_seeds = run.benchmarks / Path(top_seed_copy(0)).parent  # each seed's or group's jobs in a folder of its own
     reruns = list(top_seeds.glob("*/**/*.tsv")) if top_seeds.is_dir() else []
@@ -86,59 +102,145 @@ def _seed_values(rows: pd.DataFrame, alpha: float, correlation: bool) -> tuple[n
     return effect, ses, rows["n"].astype(float).to_numpy()
 
 
-def plan_part(rows: pd.DataFrame, alpha: float, costs: RunCosts) -> dict:
-    """One row of :data:`PLAN_COLUMNS` for one part (``rows``: its claim_parts rows over the seeds, with effect,
-    interval, n, family, sign, delta and ci_method)."""
+class PartModel(NamedTuple):
+    """A part's seeds reduced to what the planner needs (:func:`model_part`): its sign, smallest effect of interest
+    (``delta`` as reported; ``planned_delta`` on the scale decided on, Fisher's z for a correlation), Holm family,
+    the variance components over the seeds (None where they cannot be had; ``note`` says why) and notes."""
+
+    claim: str
+    part: str
+    sign: int | None
+    delta: float
+    planned_delta: float
+    family: int
+    seeds: int
+    correlation: bool
+    comp: Components | None
+    note: str
+
+    def theta(self, multiple: float) -> float:
+        """A true effect of ``multiple`` deltas in the paper's direction, on the scale decided on."""
+        return multiple * self.planned_delta * (-1 if self.sign is not None and self.sign < 0 else 1)
+
+
+def model_part(rows: pd.DataFrame, alpha: float) -> PartModel:
+    """One part's :class:`PartModel` from its claim_parts rows over the seeds (effect, interval, n, family, sign,
+    delta, ci_method, verdict); seeds that did not run it, or carry no effect or delta, are left out."""
     first = rows.iloc[0]
     sign = None if pd.isna(first["sign"]) else int(first["sign"])
-    out = dict.fromkeys(PLAN_COLUMNS, np.nan) | {"claim": first["claim"], "part": first["part"],
-                                                 "sign": first["sign"], "note": ""}
     use = rows[np.isfinite(rows["effect"].astype(float)) & np.isfinite(rows["delta"].astype(float))
                & (rows["verdict"] != "not run")]
-    out["seeds"] = len(use)
+    blank = PartModel(str(first["claim"]), str(first["part"]), sign, np.nan, np.nan, 1, len(use), False, None, "")
     if len(use) < 2:
-        return out | {"note": f"{len(use)} seed(s) carry an effect and a delta: no spread over seeds to plan from"}
-    correlation = use["ci_method"].astype(str).str.contains(FISHER_Z).any()
-    family = int(use["family"].max())
+        return blank._replace(note=f"{len(use)} seed(s) carry an effect and a delta: no spread over seeds to plan "
+                                   "from")
+    correlation = bool(use["ci_method"].astype(str).str.contains(FISHER_Z).any())
     delta = float(np.nanmedian(use["delta"].astype(float)))
+    model = blank._replace(delta=delta, planned_delta=float(fisher_z(delta)) if correlation else delta,
+                           family=int(use["family"].max()), correlation=correlation)
     effect, ses, units = _seed_values(use, alpha, correlation)
     finite = np.isfinite(ses)
-    notes = []
+    notes = ["planned on Fisher's z scale"] * correlation
     if finite.sum() >= 2:
         comp = components(effect[finite], ses[finite], units[finite])._replace(effect=float(effect.mean()),
                                                                                 seeds=len(use))
     else:  # no usable interval (unbounded rank intervals): all the spread counted as between seeds
         comp = components(effect, np.zeros_like(effect), units)
-        notes.append("seeds' intervals unbounded: all spread counted as between seeds")
-    planned_delta = float(fisher_z(delta)) if correlation else delta
+        notes.insert(0, "seeds' intervals unbounded: all spread counted as between seeds")
     if not comp.seed_sd() > 0:
-        return out | {"delta": delta, "units": comp.units, "effect": comp.effect, "tau": comp.tau,
-                      "sigma": comp.sigma, "note": "every seed gave the same effect: no spread to plan from"}
-    out.update(delta=delta, units=comp.units, effect=float(np.tanh(comp.effect)) if correlation else comp.effect,
+        notes = ["every seed gave the same effect: no spread to plan from"]
+    return model._replace(comp=comp, note="; ".join(notes))
+
+
+def _plannable(model: PartModel) -> bool:
+    return model.comp is not None and model.comp.seed_sd() > 0
+
+
+def plan_part(model: PartModel, alpha: float, costs: RunCosts) -> dict:
+    """One row of :data:`PLAN_COLUMNS` for one part."""
+    out = dict.fromkeys(PLAN_COLUMNS, np.nan) | {"claim": model.claim, "part": model.part,
+                                                 "sign": np.nan if model.sign is None else float(model.sign),
+                                                 "delta": model.delta, "seeds": model.seeds, "note": model.note}
+    if model.comp is None:
+        return out
+    comp = model.comp
+    out.update(units=comp.units, effect=float(np.tanh(comp.effect)) if model.correlation else comp.effect,
                tau=comp.tau, sigma=comp.sigma)
-    for (name, multiple, sought), key in zip(SCENARIOS, ("holds_at_2delta", "absent_at_0"), strict=True):
-        verdict = scenario_verdict(sign, sought)
-        theta = multiple * planned_delta * (-1 if sign is not None and sign < 0 else 1)
-        now = decision_probabilities(theta, comp.seed_sd(), comp.seeds, sign, planned_delta, alpha, family)
-        k = seeds_needed(comp, sign, planned_delta, alpha, theta, verdict, family)
+    if not _plannable(model):
+        return out
+    notes = [model.note] if model.note else []
+    for (name, multiple, sought), key in zip(SCENARIOS, SCENARIO_KEYS, strict=True):
+        verdict = scenario_verdict(model.sign, sought)
+        theta = model.theta(multiple)
+        now = decision_probabilities(theta, comp.seed_sd(), comp.seeds, model.sign, model.planned_delta, alpha,
+                                     model.family)
+        k = seeds_needed(comp, model.sign, model.planned_delta, alpha, theta, verdict, model.family)
         out[f"now_{key}"] = now[verdict]
         out[f"seeds_{key}"] = np.nan if k is None else k
         out[f"cpu_hours_{key}"] = costs.design_hours(k)
         if k is None:
             notes.append(f"{name}: not within {MAX_SEEDS} seeds")
-    if correlation:
-        notes.append("planned on Fisher's z scale")
     return out | {"note": "; ".join(notes)}
 
 
-def plan_parts(parts_by_seed: Mapping[int, pd.DataFrame], alpha: float, costs: RunCosts) -> pd.DataFrame:
-    """One row per part of the selected seed's claims (the first table of ``parts_by_seed``), planned over every
-    seed's claim_parts rows of that part (:func:`plan_part`)."""
+def part_models(parts_by_seed: Mapping[int, pd.DataFrame], alpha: float) -> list[PartModel]:
+    """A :class:`PartModel` per part of the selected seed's claims (the first table of ``parts_by_seed``), from
+    every seed's claim_parts rows of that part, in the selected seed's order."""
     order = list(parts_by_seed)
     stacked = pd.concat([parts_by_seed[s].assign(seed=s) for s in order], ignore_index=True)
-    rows = [plan_part(group, alpha, costs) for (_, _), group in stacked.groupby(["claim", "part"], sort=False)
+    return [model_part(group, alpha) for (_, _), group in stacked.groupby(["claim", "part"], sort=False)
             if group["seed"].iloc[0] == order[0]]
-    return pd.DataFrame(rows, columns=PLAN_COLUMNS)
+
+
+def plan_table(models: Sequence[PartModel], alpha: float, costs: RunCosts) -> pd.DataFrame:
+    """:data:`PLAN_COLUMNS`, one row per part of ``models``."""
+    return pd.DataFrame([plan_part(m, alpha, costs) for m in models], columns=PLAN_COLUMNS)
+
+
+def plan_parts(parts_by_seed: Mapping[int, pd.DataFrame], alpha: float, costs: RunCosts) -> pd.DataFrame:
+    """One row of :data:`PLAN_COLUMNS` per part of the selected seed's claims (the first table of
+    ``parts_by_seed``), planned over every seed's claim_parts rows of that part."""
+    return plan_table(part_models(parts_by_seed, alpha), alpha, costs)
+
+
+def power_curves(models: Sequence[PartModel], alpha: float, costs: RunCosts,
+                 seeds: Sequence[int] = CURVE_SEEDS) -> pd.DataFrame:
+    """:data:`CURVE_COLUMNS`: each plannable part's chance of each scenario's verdict at every design of ``seeds``
+    seeds (at the run's episodes), with the design's CPU-hours: the rows of the figure of what a decisive verdict
+    costs."""
+    rows = []
+    for m in filter(_plannable, models):
+        sd = m.comp.seed_sd()
+        for k in seeds:
+            row = {"claim": m.claim, "part": m.part, "seeds": k, "cpu_hours": costs.design_hours(k)}
+            for (_, multiple, sought), key in zip(SCENARIOS, SCENARIO_KEYS, strict=True):
+                row[key] = decision_probabilities(m.theta(multiple), sd, k, m.sign, m.planned_delta, alpha,
+                                                  m.family)[scenario_verdict(m.sign, sought)]
+            rows.append(row)
+    return pd.DataFrame(rows, columns=CURVE_COLUMNS)
+
+
+def claim_curves(curves: pd.DataFrame) -> pd.DataFrame:
+    """Per claim and design, the chance of its weakest part (the minimum over its parts): a claim's verdict is its
+    weakest deciding part's, so this bounds the chance that the claim's verdict settles from above."""
+    return curves.groupby(["claim", "seeds"], sort=False, as_index=False).agg(
+        cpu_hours=("cpu_hours", "first"), **{key: (key, "min") for key in SCENARIO_KEYS})
+
+
+def read_run(run: Run, alpha: float) -> tuple[dict[int, pd.DataFrame], RunCosts]:
+    """A finished run's parts tables (the selected seed's first, then the other top seeds' that exist, in ranking
+    order) and its :class:`RunCosts`; one clear error for a run without claims or a ranking."""
+    from ..io import read_parquet
+
+    for needed, what in ((RANKING, "seed ranking"), (CLAIM_PARTS, "claims' parts table")):
+        if not run.path(needed).is_file():
+            raise ValueError(f"no {what} at {run.path(needed)}: run the pipeline (or efish claims) first")
+    ranking = [int(s) for s in read_parquet(run.path(RANKING), "the seed ranking")["seed"]]
+    tables = {ranking[0]: read_parquet(run.path(CLAIM_PARTS), "the selected seed's parts table")}
+    for seed in ranking[1:]:
+        if (path := run.top_seed(seed).path(CLAIM_PARTS)).is_file():
+            tables[seed] = read_parquet(path, f"seed {seed}'s parts table")
+    return tables, run_costs(run, ranking, len(tables) - 1)
 
 
 def target_line() -> str:
