@@ -91,7 +91,8 @@ def tables_reference() -> str:
     claims tables."""
     from efish.analysis.registry import ANALYSES
     from efish.analysis.selection import RANKING_COLUMNS
-    from efish.claims.planner import CURVE_COLUMNS, PLAN_COLUMNS
+    from efish.claims.planner import CURVE_COLUMNS, PLAN_COLUMNS, STAGE_PLAN_COLUMNS
+    from efish.claims.power_page import CLAIM_SUMMARY_COLUMNS
     from efish.claims.recipe import RECIPE_COLUMNS, RECIPE_PART_COLUMNS
     from efish.claims.seeds import SEED_COLUMNS
     from efish.claims.verdicts import PART_COLUMNS, ROW_COLUMNS
@@ -131,9 +132,12 @@ def tables_reference() -> str:
             ("`recipe_parts.parquet`: one row per part, decided over the top seeds", "recipe-parts",
              RECIPE_PART_COLUMNS, "How: [the recipe's verdict](../claims/index.md#the-recipes-verdict)."),
             ("`power.parquet`: what a decisive verdict costs, one row per part", "power", PLAN_COLUMNS,
+             f"Where the run kept training stages, also {_codes(STAGE_PLAN_COLUMNS)}. "
              "Meanings: [what a verdict costs](../claims/power.md#columns)."),
             ("`power_curves.parquet`: the chances per part and design", "power-curves", CURVE_COLUMNS,
              "The figure's rows: [what a verdict costs](../claims/power.md#figure)."),
+            ("`power_claims.parquet`: what would settle each claim", "power-claims", CLAIM_SUMMARY_COLUMNS,
+             "Meanings: [what a verdict costs](../claims/power.md#by-claim)."),
             ("`ranking.parquet`: the seed ranking", "ranking", RANKING_COLUMNS, "")):
         out += [f"## {title} {{#{anchor}}}", "", _codes(columns), ""] + ([note, ""] if note else [])
     return "\n".join(out)

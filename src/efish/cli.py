@@ -34,7 +34,8 @@
     efish power [overrides] [--results D] [--out D] [--figures D]
                                               what a decisive verdict costs: each part planned over the top seeds,
                                               priced with the run's job times -> power.parquet, power_curves.parquet,
-                                              power.md (default results/<run>/claims), power.png|pdf (--figures)
+                                              power_claims.parquet, power.md (default results/<run>/claims),
+                                              power.png|pdf (--figures)
     efish scene NAME [overrides] --out D      field maps of config/scene/NAME.yaml -> D/NAME.parquet
     efish bench physics [overrides] [--json] [--out D]   sensing throughput, fast vs reference
     efish bench accuracy [overrides] [--out D] [--figures D]   accuracy-vs-time study -> table (--out, default
@@ -333,11 +334,12 @@ def _power_command(sub: argparse._SubParsersAction) -> None:
                      "Plan each claim part over the run's top seeds: split its effect's spread into between seeds and "
                      "within a seed, give the chance that the recipe's verdict settles (holds if the effect is twice "
                      "delta, absent if there is none) now and the seeds, priced in CPU-hours with the run's own job "
-                     "times, that reach 80%. Writes power.parquet, power_curves.parquet and power.md (--out) and "
-                     "power.png and .pdf (--figures). Nothing here changes a verdict.", "docs/claims/power.md")
+                     "times, that reach 80%; per claim the recipe left inconclusive, what would settle it. Writes "
+                     "power.parquet, power_curves.parquet, power_claims.parquet and power.md (--out) and power.png "
+                     "and .pdf (--figures). Nothing here changes a verdict.", "docs/claims/power.md")
     add_overrides(pw, example="scale=laptop", note="they name the run and its alpha")
     pw.add_argument("--results", type=Path, help="the run's results folder (default results/{run})")
-    _add_out(pw, f"folder for power.parquet, power_curves.parquet and power.md (default "
+    _add_out(pw, f"folder for power.parquet, power_curves.parquet, power_claims.parquet and power.md (default "
                  f"results/{{run}}/{Path(POWER_TABLE).parent})")
     pw.add_argument("--figures", type=Path, help=f"folder for power.png and .pdf (default "
                                                  f"figures/{{run}}/{Path(POWER_FIGURE).parent})")

@@ -16,6 +16,7 @@ from .layout import (
     CLAIMS_TABLE,
     CLAIMS_TRENDS,
     CLAIMS_TRENDS_PAGE,
+    POWER_CLAIMS,
     POWER_CURVES,
     POWER_FIGURE,
     POWER_PAGE,
@@ -67,11 +68,13 @@ def run_claims(args, cfg, started) -> None:
 def run_power(args, cfg, started) -> None:
     """``efish power``: the planner's table, its curves, page and figure for a finished run
     (:mod:`efish.claims.planner`)."""
+    import pandas as pd
+
     from .bench.timing import machine, machine_line
-    from .claims.planner import part_models, plan_table, power_curves, read_run
-    from .claims.power_page import headline, power_markdown
+    from .claims.planner import part_models, plan_table, power_curves, read_run, with_stages
+    from .claims.power_page import CLAIM_SUMMARY_COLUMNS, claim_summary, headline, power_markdown
     from .figures.power import plot_power
-    from .io import write_parquet_tables, write_text_atomic
+    from .io import read_parquet, write_parquet_tables, write_text_atomic
     from .layout import Run
 
     run = run_of(cfg, args.overrides)
@@ -79,24 +82,32 @@ def run_power(args, cfg, started) -> None:
         run = Run(args.results.name, results_root=args.results.parent)
     alpha = cfg.analysis.claims_alpha
     tables, costs = read_run(run, alpha)  # everything read (and checked) before anything is written
+    claims = (read_parquet(run.path(CLAIMS_TABLE), "the run's claims table")
+              if run.path(CLAIMS_TABLE).is_file() else None)
+    recipe = (read_parquet(run.path(RECIPE_PARTS), "the recipe's parts table")
+              if run.path(RECIPE_PARTS).is_file() else None)
     out = args.out or run.path(POWER_TABLE).parent
     figures = args.figures or (run.figures / POWER_FIGURE).parent
     models = part_models(tables, alpha)
     plan = plan_table(models, alpha, costs)
+    if run.path(CLAIMS_BY_STAGE).is_file() and run.path(CLAIMS_TRENDS).is_file():  # the run kept stages
+        plan = with_stages(plan, read_parquet(run.path(CLAIMS_BY_STAGE), "the claims along training"),
+                           read_parquet(run.path(CLAIMS_TRENDS), "the claims' trends"))
     curves = power_curves(models, alpha, costs)
+    summary = (claim_summary(plan, claims, recipe, costs) if claims is not None and recipe is not None
+               else pd.DataFrame(columns=CLAIM_SUMMARY_COLUMNS))
     seeds = ", ".join(map(str, tables))
     header = (f"Run {run.name} at scale {cfg.scale.name}, seeds {seeds} (the selected seed first), "
               f"{started.strftime('%Y-%m-%d %H:%M UTC')}; {machine_line(machine())}.")
-    written = write_parquet_tables({Path(POWER_TABLE).stem: plan, Path(POWER_CURVES).stem: curves}, out)
+    written = write_parquet_tables({Path(POWER_TABLE).stem: plan, Path(POWER_CURVES).stem: curves,
+                                    Path(POWER_CLAIMS).stem: summary}, out)
     page = out / Path(POWER_PAGE).name
-    write_text_atomic(page, power_markdown(plan, costs, header, alpha))
+    write_text_atomic(page, power_markdown(plan, costs, header, alpha, summary if len(summary) else None))
     drawn = plot_power(curves, plan, figures / Path(POWER_FIGURE).name,
                        f"What a decisive verdict costs: run {run.name}, seeds {seeds}")
     write_metadata(out, cfg, started, args, name="power.provenance.json", results=str(run.results),
                    seeds=list(tables), costs=costs._asdict())
-    shown = ["claim", "part", "seeds", "now_holds_at_2delta", "seeds_holds_at_2delta", "cpu_hours_holds_at_2delta",
-             "now_absent_at_0", "seeds_absent_at_0"]
-    print(plan[shown].to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+    print("\n".join(summary["line"]))
     print(headline(plan, costs))
     print(f"wrote {', '.join(map(str, [*written, page, *drawn]))}")
 

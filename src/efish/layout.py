@@ -16,8 +16,8 @@ its tables under ``results/<run>/`` and its drawings under ``figures/<run>/``::
       learning/stage_K/               the same for the selected seed's K-th kept training stage
       learning/                       claims_by_stage, claims_trends .parquet, claims.md (claims along training)
       scenes/<scene>.parquet          field maps
-      claims/                         claims, claim_parts, recipe_parts .parquet, claims.md; power, power_curves
-                                      .parquet, power.md (what a decisive verdict costs)
+      claims/                         claims, claim_parts, recipe_parts .parquet, claims.md; power, power_curves,
+                                      power_claims .parquet, power.md (what a decisive verdict costs)
       bench/                          benchmark tables
       logs/, benchmarks/              one .log and one Snakemake .tsv per job
     figures/<run>/
@@ -259,6 +259,7 @@ RECIPE_PARTS = "claims/recipe_parts.parquet"  # each part decided over the top s
 #: and the figure's stem under ``figures/<run>/``.
 POWER_TABLE = "claims/power.parquet"
 POWER_CURVES = "claims/power_curves.parquet"
+POWER_CLAIMS = "claims/power_claims.parquet"  # one line per claim: what would decide it
 POWER_PAGE = "claims/power.md"
 POWER_FIGURE = "claims/power"
 #: The claims along training (``efish claims-by-stage``): the stages' parts stacked and each part's trend, under

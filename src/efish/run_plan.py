@@ -44,6 +44,7 @@ from .layout import (
     CLAIMS_TRENDS,
     CLAIMS_TRENDS_PAGE,
     FIGURE_FORMATS,
+    POWER_CLAIMS,
     POWER_CURVES,
     POWER_FIGURE,
     POWER_PAGE,
@@ -249,7 +250,7 @@ def learning_outputs(run: Run) -> dict[str, str]:
 
 def power_outputs(run: Run) -> dict[str, str]:
     """What ``efish power`` writes for ``run``: the plan, its curves, its page and its figure (png, pdf)."""
-    tables = {"table": POWER_TABLE, "curves": POWER_CURVES, "page": POWER_PAGE}
+    tables = {"table": POWER_TABLE, "curves": POWER_CURVES, "claims": POWER_CLAIMS, "page": POWER_PAGE}
     figure = {ext: str(run.figures / f"{POWER_FIGURE}.{ext}") for ext in FIGURE_FORMATS}
     return {name: str(run.path(path)) for name, path in tables.items()} | figure
 

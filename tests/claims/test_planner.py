@@ -21,7 +21,7 @@ from efish.claims.planner import (
 )
 from efish.claims.power import decision_probabilities
 from efish.cli import main
-from efish.layout import CLAIM_PARTS, RANKING, Run
+from efish.layout import CLAIM_PARTS, CLAIMS_BY_STAGE, CLAIMS_TABLE, CLAIMS_TRENDS, RANKING, RECIPE_PARTS, Run
 
 ALPHA = 0.05
 
@@ -86,6 +86,7 @@ def test_run_costs_reads_the_runs_own_benchmarks(tmp_path):
     benchmark(run.benchmark("seeds/patchy4"), 999.0)  # the stacked table of all top seeds: not a seed's rerun
     costs = run_costs(run, [1, 2], other_top_seeds=1)
     assert (costs.train_s, costs.selection_s, costs.rerun_s) == (400.0, 10.0, 80.0)
+    assert costs.run_s == 300 + 500 + 2 * 10 + 60 + 20 + 999  # every job of the run
     assert costs.design_hours(9) == pytest.approx(9 * 490 / 3600) and np.isnan(costs.design_hours(None))
     unpriced = run_costs(Run("empty", results_root=tmp_path), [1], 0)  # e.g. a sweep's point that copied its training
     assert np.isnan(unpriced.design_hours(3)) and "unpriced" in unpriced.seeds_timed
@@ -125,6 +126,10 @@ def write_run(root, effects: dict[int, float]) -> Run:
         parts_table(rng, {"p": effects[seed]}, 0.05, 0.2, 8, 0.1).to_parquet(where.path(CLAIM_PARTS))
         benchmark(run.benchmark(f"train/seed_{seed}"), 400.0)
         benchmark(run.benchmark(f"selection/seed_{seed}"), 20.0)
+    pd.DataFrame({"claim": ["C9"], "recipe_verdict": ["inconclusive"], "recipe_parts": ["1 inconclusive"]}).to_parquet(
+        run.path(CLAIMS_TABLE))
+    pd.DataFrame({"claim": ["C9"], "part": ["p"], "decides": [True], "verdict": ["inconclusive"]}).to_parquet(
+        run.path(RECIPE_PARTS))
     return run
 
 
@@ -139,7 +144,13 @@ def test_power_command_writes_its_tables_page_and_figure(tmp_path, capsys):
     page = (out / "power.md").read_text()
     assert "| C9 | p |" in page and "1 of 1 parts planned" in page and "0.117 CPU-hours" in page  # 420 s a seed
     assert (figures / "power.png").stat().st_size > 0 and (figures / "power.pdf").exists()
-    assert "parts reach 80%" in capsys.readouterr().out
+    summary = pd.read_parquet(out / "power_claims.parquet").iloc[0]
+    k = int(plan["seeds_holds_at_2delta"].iloc[0])
+    assert summary["seeds_holds_at_2delta"] == k and summary["undecided"] == 1 and summary["unplanned"] == 0
+    assert summary["runs_holds_at_2delta"] == pytest.approx(k * 420 / (3 * 420))  # the run: 3 seeds' jobs
+    assert f"about {k} seeds" in summary["line"] and f"- {summary['line']}" in page
+    printed = capsys.readouterr().out
+    assert "parts reach 80%" in printed and summary["line"] in printed
 
 
 def test_power_command_without_claims_is_one_line_and_writes_nothing(tmp_path, capsys):
@@ -160,3 +171,19 @@ def test_a_run_without_training_benchmarks_is_planned_in_seeds_not_priced(tmp_pa
     assert plan["seeds_holds_at_2delta"].notna().all() and plan["cpu_hours_holds_at_2delta"].isna().all()
     assert "not priced" in (out / "power.md").read_text()
     assert len(claim_curves(pd.read_parquet(out / "power_curves.parquet"))) == len(CURVE_SEEDS)
+
+
+def test_where_the_run_kept_stages_each_part_shows_its_effect_along_training(tmp_path):
+    run = write_run(tmp_path / "results", {2: 0.3, 5: 0.25, 1: 0.35})
+    stacked = pd.DataFrame({"claim": "C9", "part": "p", "stage": [2, 1], "env_steps": [240_000, 60_000],
+                            "effect": [0.3, 0.05]})
+    trends = pd.DataFrame({"claim": ["C9"], "part": ["p"], "trend": ["moving toward the paper's sign"]})
+    for table, name in ((stacked, CLAIMS_BY_STAGE), (trends, CLAIMS_TRENDS)):
+        run.path(name).parent.mkdir(parents=True, exist_ok=True)
+        table.to_parquet(run.path(name))
+    out = tmp_path / "power"
+    assert main(["power", "scale=laptop", "--results", str(run.results), "--out", str(out),
+                 "--figures", str(tmp_path / "figures")]) == 0
+    row = pd.read_parquet(out / "power.parquet").iloc[0]
+    assert row["stage_effects"] == "60k: 0.05, 240k: 0.3" and row["trend"] == "moving toward the paper's sign"
+    assert "| 60k: 0.05, 240k: 0.3 | moving toward the paper's sign |" in (out / "power.md").read_text()

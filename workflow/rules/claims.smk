@@ -59,6 +59,7 @@ rule power:
         recipe=results(RECIPE_PARTS),
         ranking=results(RANKING),
         seed_parts=other_seed_parts,
+        stages=power_stages,
     output:
         **power_outputs(),
     log:

@@ -292,6 +292,15 @@ def learning_outputs(reported=False):
     return outputs
 
 
+def power_stages(wildcards):
+    """The claims along training, where the run keeps stages (scale.learning): efish power shows each part's effect
+    at every stage beside its plan."""
+    if not plan_of(wildcards).cfg.scale.learning:
+        return []
+    outputs = run_plan.learning_outputs(Run(wildcards.run))
+    return [outputs["table"], outputs["trends"]]
+
+
 def power_outputs():
     """What efish power writes (efish.run_plan.power_outputs); its figure's PNG goes into the report, beside the
     claims."""

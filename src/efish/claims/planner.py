@@ -35,8 +35,8 @@ from .power import standard_error as interval_se
 from .recipe import FISHER_Z, fisher_z
 from .verdicts import interval_level
 
-__all__ = ["CURVE_COLUMNS", "PLAN_COLUMNS", "PartModel", "RunCosts", "claim_curves", "part_models", "plan_parts",
-           "plan_table", "power_curves", "read_run", "run_costs"]
+__all__ = ["CURVE_COLUMNS", "PLAN_COLUMNS", "STAGE_PLAN_COLUMNS", "PartModel", "RunCosts", "claim_curves", "part_models", "plan_parts",
+           "plan_table", "power_curves", "read_run", "run_costs", "with_stages"]
 
 #: The column suffix of each of :data:`~efish.claims.power.SCENARIOS`, in its order.
 SCENARIO_KEYS = ("holds_at_2delta", "absent_at_0")
@@ -50,17 +50,22 @@ CURVE_COLUMNS = ["claim", "part", "seeds", "cpu_hours", *SCENARIO_KEYS]
 PLAN_COLUMNS = ["claim", "part", "sign", "delta", "seeds", "units", "effect", "tau", "sigma",
                 "now_holds_at_2delta", "now_absent_at_0", "seeds_holds_at_2delta", "seeds_absent_at_0",
                 "cpu_hours_holds_at_2delta", "cpu_hours_absent_at_0", "note"]
+#: Where the run kept training stages (the claims along training), the plan gains the selected seed's effect at each
+#: stage (``stage_effects``: "240k: 0.01, 480k: 0.05", env steps and effect) and the part's trend over them: an
+#: effect still growing says longer training, not more seeds, is the lever.
+STAGE_PLAN_COLUMNS = ["stage_effects", "trend"]
 
 
 class RunCosts(NamedTuple):
     """What one more seed costs in this run, in CPU-seconds: its training, its selection episodes, and its reruns of
     the claims' assays at the run's episodes (``rerun_s``, from the other top seeds' jobs); ``seeds_timed`` says how
-    many seeds each mean is over."""
+    many seeds each mean is over; ``run_s`` is what the whole run cost."""
 
     train_s: float
     selection_s: float
     rerun_s: float
     seeds_timed: str
+    run_s: float = np.nan  # the whole run's CPU time (every job's benchmark file), for "x times this run"
 
     def design_hours(self, seeds: int | None) -> float:
         """CPU-hours of a design of ``seeds`` seeds at the run's episodes (NaN when no design reaches it)."""
@@ -88,7 +93,8 @@ def run_costs(run: Run, seeds: Sequence[int], other_top_seeds: int) -> RunCosts:
     rerun_s = sum(map(_cpu_seconds, reruns)) / other_top_seeds if other_top_seeds and reruns else 0.0
     return RunCosts(float(np.mean([_cpu_seconds(p) for p in train])),
                     float(np.mean([_cpu_seconds(p) for p in selection])) if selection else 0.0, float(rerun_s),
-                    f"training {len(train)}, selection {len(selection)}, reruns of {other_top_seeds} seeds")
+                    f"training {len(train)}, selection {len(selection)}, reruns of {other_top_seeds} seeds",
+                    float(sum(map(_cpu_seconds, run.benchmarks.rglob("*.tsv")))))
 
 
 def _seed_values(rows: pd.DataFrame, alpha: float, correlation: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -225,6 +231,22 @@ def claim_curves(curves: pd.DataFrame) -> pd.DataFrame:
     weakest deciding part's, so this bounds the chance that the claim's verdict settles from above."""
     return curves.groupby(["claim", "seeds"], sort=False, as_index=False).agg(
         cpu_hours=("cpu_hours", "first"), **{key: (key, "min") for key in SCENARIO_KEYS})
+
+
+def _steps(n: float) -> str:
+    """Env steps in short: 240000 -> 240k, 3000000 -> 3M."""
+    return f"{n / 1e6:.3g}M" if n >= 1e6 else f"{n / 1e3:.3g}k" if n >= 1e3 else f"{n:.0f}"
+
+
+def with_stages(plan: pd.DataFrame, stacked: pd.DataFrame, trends: pd.DataFrame) -> pd.DataFrame:
+    """``plan`` with :data:`STAGE_PLAN_COLUMNS` from the claims along training (``stacked``: claims_by_stage.parquet,
+    ``trends``: claims_trends.parquet); a part they do not hold gets empty cells."""
+    effects = {key: ", ".join(f"{_steps(r.env_steps)}: {r.effect:.3g}" for r in rows.sort_values("env_steps")
+                              .itertuples(index=False))
+               for key, rows in stacked.groupby(["claim", "part"], sort=False)}
+    trend = {(r.claim, r.part): r.trend for r in trends.itertuples(index=False)}
+    keys = list(zip(plan["claim"], plan["part"], strict=True))
+    return plan.assign(stage_effects=[effects.get(k, "") for k in keys], trend=[trend.get(k, "") for k in keys])
 
 
 def read_run(run: Run, alpha: float) -> tuple[dict[int, pd.DataFrame], RunCosts]:

@@ -25,16 +25,22 @@ def _seeds(value, hours) -> str:
     return f"{int(value)} ({hours:.3g} h)" if np.isfinite(hours) else str(int(value))
 
 
-def power_markdown(plan: pd.DataFrame, costs: RunCosts, header: str, alpha: float) -> str:
-    """The page: a header, what one seed costs, how to read the table, and one row per part of ``plan``
+def power_markdown(plan: pd.DataFrame, costs: RunCosts, header: str, alpha: float,
+                   summary: pd.DataFrame | None = None) -> str:
+    """The page: a header, what one seed costs, one line per claim (``summary``, :func:`claim_summary`, where the
+    run has its claims table), how to read the table, and one row per part of ``plan``
     (:data:`efish.claims.planner.PLAN_COLUMNS`)."""
     seed_h = costs.design_hours(1)
     price = (f"One more seed costs {seed_h:.3g} CPU-hours in this run: training {costs.train_s / 3600:.3g} h, "
              f"selection {costs.selection_s / 3600:.3g} h, reruns of the claims' assays {costs.rerun_s / 3600:.3g} h "
              f"(means over {costs.seeds_timed}; Snakemake's benchmark files of this run's jobs)."
              if np.isfinite(seed_h) else f"The designs are not priced: {costs.seeds_timed}.")
+    if np.isfinite(seed_h) and costs.run_s > 0:
+        price += f" The whole run cost {costs.run_s / 3600:.3g} CPU-hours."
     planned = plan["tau"].notna() & plan["now_holds_at_2delta"].notna()
-    lines = ["# What a decisive verdict costs\n", header, "", price, "",
+    by_claim = [] if summary is None else ["## By claim\n", *[f"- {line}" for line in summary["line"]], "",
+                                            "## By part\n"]
+    lines = ["# What a decisive verdict costs\n", header, "", price, "", *by_claim,
              f"For every part the recipe decides over seeds: the spread of its effect over this run's seeds split "
              f"into between seeds (tau) and within a seed's episodes (sigma, per episode), and from them the chance "
              f"that the recipe's verdict (alpha {alpha:g}, Holm family counted) settles now and the {target_line()}. "
@@ -45,13 +51,71 @@ def power_markdown(plan: pd.DataFrame, costs: RunCosts, header: str, alpha: floa
              "| claim | part | delta | seeds | effect | tau | sigma | holds at 2 delta: now | seeds (CPU-h) "
              "| absent at 0: now | seeds (CPU-h) | note |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    stages = "trend" in plan.columns
+    if stages:
+        lines[-2] = lines[-2].rstrip(" |") + " | along training (env steps: effect) | trend |"
+        lines[-1] += "---|---|"
     for row in plan.itertuples(index=False):
         cells = [row.claim, row.part, _number(row.delta), str(int(row.seeds)), _number(row.effect),
                  _number(row.tau), _number(row.sigma), _chance(row.now_holds_at_2delta),
                  _seeds(row.seeds_holds_at_2delta, row.cpu_hours_holds_at_2delta), _chance(row.now_absent_at_0),
-                 _seeds(row.seeds_absent_at_0, row.cpu_hours_absent_at_0), row.note]
+                 _seeds(row.seeds_absent_at_0, row.cpu_hours_absent_at_0), row.note,
+                 *([row.stage_effects, row.trend] if stages else [])]
         lines.append("| " + " | ".join(str(c).replace("|", "/") for c in cells) + " |")
     return "\n".join(lines) + "\n"
+
+
+#: The columns of :func:`claim_summary`: per claim, its recipe verdict and parts tally, its undecided deciding parts,
+#: and the design that would decide it in each scenario with its CPU-hours and its multiple of this run's.
+CLAIM_SUMMARY_COLUMNS = ["claim", "recipe_verdict", "recipe_parts", "undecided", "unplanned", "seeds_holds_at_2delta",
+                         "cpu_hours_holds_at_2delta", "runs_holds_at_2delta", "line"]
+UNDECIDED = "inconclusive"
+
+
+def _decider(plan_rows: pd.DataFrame, costs: RunCosts) -> tuple[float, float, float, str]:
+    """(seeds, CPU-hours, multiple of this run, words) of the design that settles every one of ``plan_rows`` in the
+    scenario of an effect of twice delta: the most seeds any one of them needs."""
+    k = plan_rows["seeds_holds_at_2delta"]
+    if k.isna().any():
+        return np.nan, np.nan, np.nan, f"not within {MAX_SEEDS} seeds"
+    seeds = int(k.max())
+    hours = costs.design_hours(seeds)
+    runs = hours * 3600 / costs.run_s if np.isfinite(hours) and costs.run_s > 0 else np.nan
+    priced = (f" ({hours:.3g} CPU-hours here" + (f", {runs:.2g}x this run" if np.isfinite(runs) else "") + ")"
+              if np.isfinite(hours) else "")
+    return seeds, hours, runs, f"about {seeds} seeds{priced}"
+
+
+def claim_summary(plan: pd.DataFrame, claims: pd.DataFrame, recipe: pd.DataFrame, costs: RunCosts) -> pd.DataFrame:
+    """:data:`CLAIM_SUMMARY_COLUMNS`, one row per claim of ``claims`` (the run's claims table, with the recipe's
+    columns): for a claim the recipe left inconclusive, the design that would settle its inconclusive deciding
+    parts (``recipe``: recipe_parts.parquet) if each part's true effect were twice its delta."""
+    rows = []
+    by_part = plan.set_index(["claim", "part"])
+    for claim in claims.itertuples(index=False):
+        verdict = getattr(claim, "recipe_verdict", None)
+        row = dict.fromkeys(CLAIM_SUMMARY_COLUMNS, np.nan) | {
+            "claim": claim.claim, "recipe_verdict": verdict, "recipe_parts": getattr(claim, "recipe_parts", ""),
+            "undecided": 0, "unplanned": 0}
+        parts = recipe[(recipe["claim"] == claim.claim) & recipe["decides"].astype(bool)
+                       & (recipe["verdict"] == UNDECIDED)]
+        keys = [(claim.claim, part) for part in parts["part"] if (claim.claim, part) in by_part.index]
+        planned = by_part.loc[keys] if keys else by_part.iloc[:0]
+        planned = planned[planned["now_holds_at_2delta"].notna()]
+        row.update(undecided=len(parts), unplanned=len(parts) - len(planned))
+        words = f"{claim.claim}: recipe {verdict or 'not decided'}" + (f" ({row['recipe_parts']})"
+                                                                        if row["recipe_parts"] else "")
+        if verdict == UNDECIDED and len(parts):
+            if len(planned):
+                seeds, hours, runs, design = _decider(planned, costs)
+                row.update(seeds_holds_at_2delta=seeds, cpu_hours_holds_at_2delta=hours, runs_holds_at_2delta=runs)
+                words += (f"; if its {len(planned)} planned undecided part(s) had twice their delta, {design} "
+                          "would settle them")
+            if row["unplanned"]:
+                words += f"; {row['unplanned']} undecided part(s) cannot be planned (see the table)"
+        row["line"] = words
+        rows.append(row)
+    return pd.DataFrame(rows, columns=CLAIM_SUMMARY_COLUMNS)
 
 
 def headline(plan: pd.DataFrame, costs: RunCosts) -> str:
