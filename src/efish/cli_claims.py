@@ -224,18 +224,22 @@ def run_compare_claims(args, cfg, started) -> None:
     from .claims.report import agreement_lines, compare_claims, load_claims
     from .figures.claims_grid import draw_heatmap
 
-    wanted = [*args.runs, *(_sweep_runs(args) if args.sweep else [])]
+    swept = _sweep_points(args) if args.sweep else []
+    wanted = [*args.runs, *(run for run, _ in swept)]
     if len(wanted) < 2:
         raise ValueError(f"compare-claims needs two or more runs, got {len(wanted)}: name them or give --sweep")
     if args.out and args.out.suffix not in TABLE_SUFFIXES:
         raise ValueError(f"--out {args.out}: the table is written as {' or '.join(TABLE_SUFFIXES)}")
     loaded = [load_claims(run, args.results) for run in wanted]  # every table read before anything is written
-    names = [name if [n for n, _ in loaded].count(name) == 1 else f"{name} ({i + 1})"
-             for i, (name, _) in enumerate(loaded)]  # two folders of one name (two results roots) stay apart
+    labels = [name for name, _ in loaded[:len(args.runs)]] + [label for _, label in swept]  # a point by its values
+    names = [name if labels.count(name) == 1 else f"{name} ({i + 1})"
+             for i, name in enumerate(labels)]  # two folders of one name (two results roots) stay apart
     tables = dict(zip(names, (table for _, table in loaded), strict=True))
     grid = claims_grid(tables) if len(loaded) > 2 or args.out or args.heatmap else None
+    if swept:
+        print("\n".join(f"{label}: {run}" for run, label in swept))
     if len(loaded) == 2:
-        (name_a, a), (name_b, b) = loaded
+        (name_a, name_b), (a, b) = names, tables.values()
         print(compare_claims(a, b, (name_a, name_b)).to_string(index=False))
         print("\n".join(agreement_lines(a, b, (name_a, name_b))))
     else:
@@ -248,15 +252,20 @@ def run_compare_claims(args, cfg, started) -> None:
         print(f"wrote {args.heatmap}")
 
 
-def _sweep_runs(args) -> list[str]:
-    """The run folders of ``--sweep`` at ``--scale`` with ``--overrides``, in grid order (as the workflow names
-    them)."""
+def _sweep_points(args) -> list[tuple[str, str]]:
+    """(run folder, label) of each point of ``--sweep`` at ``--scale`` with ``--overrides``, in grid order (as the
+    workflow names them; the label is the point's values, :func:`efish.sweep.sweep_points`)."""
     import shlex
 
     from .run_plan import DEFAULT_SCALE, PlanError
-    from .sweep import sweep_runs
+    from .sweep import sweep_points
 
     try:
-        return sweep_runs(args.scale or DEFAULT_SCALE, shlex.split(args.overrides), args.sweep)
+        return sweep_points(args.scale or DEFAULT_SCALE, shlex.split(args.overrides), args.sweep)
     except PlanError as exc:
         raise ValueError(str(exc)) from None
+
+
+def _sweep_runs(args) -> list[str]:
+    """The run folders of ``--sweep`` (:func:`_sweep_points` without the labels)."""
+    return [run for run, _ in _sweep_points(args)]

@@ -133,6 +133,16 @@ def check_alike(plans: Sequence[RunPlan]) -> None:
                             "hidden states (assay.record_hidden): sweep it in separate calls")
 
 
+def sweep_points(scale: str, overrides: Sequence[str], sweep: str) -> list[tuple[str, str]]:
+    """(run folder, label) of each point of a sweep, in grid order: the label is the point's values as the grid
+    gives them (``analysis.claims_alpha=0.01``, several joined by spaces), what a reader of a table or a heatmap
+    of the sweep wants instead of the folder's hash."""
+    grid = sweep_grid(sweep)
+    points = sweep_overrides(scale, overrides, grid)
+    return [(run_name(scale, point), " ".join(values))
+            for point, values in zip(points, grid_points(grid), strict=True)]
+
+
 def sweep_runs(scale: str, overrides: Sequence[str], sweep: str) -> list[str]:
     """The run folders of a sweep, in grid order (what ``efish compare-claims --sweep`` reads)."""
-    return [run_name(scale, point) for point in sweep_overrides(scale, overrides, sweep_grid(sweep))]
+    return [run for run, _ in sweep_points(scale, overrides, sweep)]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import matplotlib
+import numpy as np
 import pandas as pd
 import pytest
 from matplotlib.colors import to_hex
@@ -37,9 +38,18 @@ def test_the_table_has_a_row_per_claim_and_each_runs_verdicts_and_effects_recipe
     assert grid["a recipe"].tolist() == ["holds", "absent", "opposite"]
     assert grid["b verdict"].tolist() == ["absent", "holds", "absent"]
     assert grid["c verdict"].tolist() == ["not run", "-", "opposite"] and pd.isna(grid.loc[1, "c effect"])
-    verdicts, effects = headline(grid, ["a", "b", "c"])
+    verdicts, effects, recipe = headline(grid, ["a", "b", "c"])
     assert verdicts.loc["C10"].tolist() == ["opposite", "holds", "opposite"]
     assert effects.loc["C10"].tolist() == [0.4, 2.5, -1.0]  # a's recipe has no number there: its seed's effect
+    assert recipe.loc["C10"].tolist() == [True, True, False]  # c has no recipe: its selected seed's verdict
+
+
+def test_where_the_recipe_did_not_decide_the_headline_is_the_selected_seeds_and_not_run_shows_no_effect():
+    rows = claims_rows({"C2": "holds", "C3": "not run"}).assign(effect=[0.7, 0.2], recipe_verdict=["not run", "not run"],
+                                                                recipe_effect=[float("nan"), 0.9])
+    verdicts, effects, recipe = headline(claims_grid({"a": rows}), ["a"])
+    assert verdicts["a"].tolist() == ["holds", "not run"] and recipe["a"].tolist() == [False, False]
+    assert effects.loc["C2", "a"] == 0.7 and np.isnan(effects.loc["C3", "a"])  # the seed's effect; none where not run
 
 
 def test_the_heatmap_colours_each_cell_by_its_verdict_and_prints_its_effect(three_runs):
@@ -54,7 +64,7 @@ def test_the_heatmap_colours_each_cell_by_its_verdict_and_prints_its_effect(thre
         colour = {verdict: to_hex(c) for verdict, c in VERDICT_COLOURS.items()}
         assert cells["C2 a"] == colour["holds"] and cells["C2 b"] == colour["not decidable"]
         assert cells["C10 c"] == colour["opposite"] and cells["C3 c"] == "#ffffff"
-        assert [t.get_text() for t in ax.texts] == ["0.5", "1.5", "2", "3.5", "0.4", "2.5", "-1"]
+        assert [t.get_text() for t in ax.texts] == ["0.5", "1.5", "2", "3.5", "0.4", "2.5", "-1*"]  # c: its seed's
         assert [t.get_text() for t in ax.get_yticklabels()] == ["C2", "C3", "C10"]
     finally:
         plt.close(fig)
@@ -93,3 +103,23 @@ def test_compare_claims_names_a_sweeps_runs_as_the_workflow_does(three_runs, tmp
     assert main(["compare-claims", "--sweep", "analysis.claims_resamples=100,400", "--scale", "smoke"]) == 2
     err = capsys.readouterr().err
     assert "no claims table for 'smoke-" in err and "'smoke'" not in err
+
+
+def test_a_sweeps_points_are_named_by_their_values_and_each_interval_by_its_alpha(tmp_path, capsys, monkeypatch):
+    from efish.sweep import sweep_points
+
+    monkeypatch.chdir(tmp_path)
+    sweep = "analysis.claims_alpha=0.05,0.01"
+    points = sweep_points("smoke", [], sweep)
+    assert [label for _, label in points] == ["analysis.claims_alpha=0.05", "analysis.claims_alpha=0.01"]
+    for (run, _), alpha in zip(points, (0.05, 0.01), strict=True):
+        folder = tmp_path / "results" / run / "claims"
+        folder.mkdir(parents=True)
+        claims_rows({"C2": "holds"}).to_parquet(folder / "claims.parquet")
+        (folder / "config.yaml").write_text(f"analysis:\n  claims_alpha: {alpha}\n")
+    assert main(["compare-claims", "--sweep", sweep, "--scale", "smoke", "--out", "grid.csv"]) == 0
+    printed = capsys.readouterr().out
+    assert "analysis.claims_alpha=0.01 effect [CI, alpha 0.01]" in printed
+    assert "analysis.claims_alpha=0.05 effect [CI, alpha 0.05]" in printed
+    assert f"analysis.claims_alpha=0.01: {points[1][0]}" in printed  # which folder each label is
+    assert "analysis.claims_alpha=0.01 verdict" in pd.read_csv(tmp_path / "grid.csv").columns

@@ -3,7 +3,8 @@ claims x runs, which `efish.figures.claims_grid` draws as a heatmap.
 
 The table keeps, per run, ``<run> recipe`` and ``<run> recipe effect`` (where its claims table has the recipe's
 verdict: its top seeds together, :mod:`efish.claims.recipe`), then ``<run> verdict`` and ``<run> effect`` (its
-selected seed's). The heatmap shows each run's headline (:func:`headline`): the recipe's verdict where it has one.
+selected seed's). The heatmap shows each run's headline (:func:`headline`): the recipe's verdict where it decided the
+claim, else the selected seed's.
 """
 
 from __future__ import annotations
@@ -47,20 +48,32 @@ def claims_grid(tables: Mapping[str, pd.DataFrame]) -> pd.DataFrame:
     return grid
 
 
-def headline(grid: pd.DataFrame, runs: list[str]) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """Each run's headline verdict and effect per claim (claims x runs): the recipe's verdict where the run has it,
-    else its selected seed's; the recipe's effect where it has a number, else the selected seed's."""
-    def verdict(run: str) -> pd.Series:
-        return grid.get(f"{run} recipe", grid[f"{run} verdict"])
+#: A run's recipe verdict that says nothing of the claim: the recipe did not decide it (one top seed, or the claim's
+#: assays not rerun), so the run's headline is its selected seed's verdict.
+NO_RECIPE = ("-", "not run")
 
-    def effect(run: str) -> pd.Series:
-        own = grid[f"{run} effect"]
-        return grid[f"{run} recipe effect"].fillna(own) if f"{run} recipe effect" in grid.columns else own
 
+def headline(grid: pd.DataFrame, runs: list[str]) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame]:
+    """Each run's headline verdict and effect per claim (claims x runs), and whether it is the recipe's: the
+    recipe's verdict where the run has one that decided the claim, else its selected seed's; the effect of the
+    verdict shown (the recipe's where it has a number, else the selected seed's), none where the verdict shown is
+    "not run"."""
     index = grid["claim"]
-    verdicts = pd.DataFrame({run: verdict(run).to_numpy() for run in runs}, index=index)
-    effects = pd.DataFrame({run: effect(run).to_numpy(dtype=float) for run in runs}, index=index)
-    return verdicts, effects
+    verdicts, effects, recipe = {}, {}, {}
+    for run in runs:
+        own, own_effect = grid[f"{run} verdict"], grid[f"{run} effect"].astype(float)
+        if f"{run} recipe" in grid.columns:
+            decided = ~grid[f"{run} recipe"].isin(NO_RECIPE)
+            verdict = grid[f"{run} recipe"].where(decided, own)
+            effect = grid.get(f"{run} recipe effect", own_effect).astype(float).fillna(own_effect)
+            effect = effect.where(decided, own_effect)
+        else:
+            decided, verdict, effect = pd.Series(False, index=grid.index), own, own_effect
+        verdicts[run] = verdict.to_numpy()
+        effects[run] = effect.where(verdict != "not run").to_numpy(dtype=float)
+        recipe[run] = decided.to_numpy()
+    return (pd.DataFrame(verdicts, index=index), pd.DataFrame(effects, index=index),
+            pd.DataFrame(recipe, index=index))
 
 
 def write_table(grid: pd.DataFrame, path: Path) -> None:

@@ -41,7 +41,7 @@ __all__ = ["CURVE_COLUMNS", "PLAN_COLUMNS", "STAGE_PLAN_COLUMNS", "PartModel", "
 #: The column suffix of each of :data:`~efish.claims.power.SCENARIOS`, in its order.
 SCENARIO_KEYS = ("holds_at_2delta", "absent_at_0")
 #: The designs the figure draws: seeds at the run's episodes.
-CURVE_SEEDS = (2, 3, 4, 5, 6, 8, 10, 12, 16, 20, 24, 32, 40)
+CURVE_SEEDS = (2, 3, 4, 5, 6, 8, 10, 12, 16, 20, 24, 32, 40, 50, 64, 80, 100, 128, 160, 200)
 #: One row per plannable part and design: the chance of each scenario's verdict and the design's CPU-hours.
 CURVE_COLUMNS = ["claim", "part", "seeds", "cpu_hours", *SCENARIO_KEYS]
 

@@ -105,14 +105,38 @@ def load_claims(where: str | Path, results_root: str | Path = RESULTS_ROOT) -> t
         raise ValueError(f"no claims table for {str(where)!r}: tried {', '.join(map(str, candidates))} "
                          "(run efish claims first)")
     run = path.parent.parent.name if path.parent.name == "claims" else path.parent.name
-    return run, read_parquet(path, f"the claims table {path}")
+    table = read_parquet(path, f"the claims table {path}")
+    table.attrs[ALPHA_ATTR] = _alpha_beside(path)
+    return run, table
+
+
+#: Where :func:`load_claims` keeps the alpha the table was computed at (``analysis.claims_alpha``; None if unknown).
+ALPHA_ATTR = "claims_alpha"
+
+
+def _alpha_beside(path: Path) -> float | None:
+    """``analysis.claims_alpha`` of the config.yaml efish claims writes beside a claims table; None without it."""
+    import yaml
+
+    config = path.parent / "config.yaml"
+    try:
+        return float(yaml.safe_load(config.read_text())["analysis"]["claims_alpha"])
+    except (OSError, KeyError, TypeError, ValueError, yaml.YAMLError):
+        return None
+
+
+def interval_header(table: pd.DataFrame) -> str:
+    """``effect [CI, alpha 0.05]``: the effect column's header, naming the alpha its intervals are at (each part's
+    interval is at level 1 - 2 alpha / family, the one its verdict reads); ``effect [CI]`` when it is unknown."""
+    alpha = table.attrs.get(ALPHA_ATTR)
+    return "effect [CI]" if alpha is None else f"effect [CI, alpha {alpha:g}]"
 
 
 def compare_claims(a: pd.DataFrame, b: pd.DataFrame, names: tuple[str, str] = ("A", "B")) -> pd.DataFrame:
     """Two claims tables side by side, one row per claim: each run's recipe verdict (its top seeds together,
     :mod:`efish.claims.recipe`; '-' for a run whose table has none), its selected seed's verdict, seeds_agree (the
-    verdicts across its top seeds; '-' where absent), effect [CI] (the selected seed's, at the level its verdict
-    reads) and n, and whether a verdict moved: ``moved``
+    verdicts across its top seeds; '-' where absent), effect [CI, alpha a] (the selected seed's, at the level its
+    verdict reads, :func:`interval_header`) and n, and whether a verdict moved: ``moved``
     marks the recipe verdict when both runs have one, else the selected seed's. A claim only one table has shows '-'
     on the other side."""
     def side(t: pd.DataFrame, name: str) -> pd.DataFrame:
@@ -120,7 +144,7 @@ def compare_claims(a: pd.DataFrame, b: pd.DataFrame, names: tuple[str, str] = ("
         recipe = t["recipe_verdict"] if has_recipe(t) else "-"
         return pd.DataFrame({"claim": t["claim"], "panel": t["panel"], f"{name} recipe": recipe,
                              f"{name} verdict": t["verdict"], f"{name} seeds_agree": agree,
-                             f"{name} effect [CI]": _effects(t), f"{name} n": t["n"]})
+                             f"{name} {interval_header(t)}": _effects(t), f"{name} n": t["n"]})
 
     if names[0] == names[1]:
         names = (f"{names[0]} (A)", f"{names[1]} (B)")

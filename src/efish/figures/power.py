@@ -47,7 +47,7 @@ def plot_power(curves: pd.DataFrame, plan: pd.DataFrame, stem: Path, title: str)
     priced = bool(len(by_claim)) and bool(np.isfinite(by_claim["cpu_hours"]).all())
     x = "cpu_hours" if priced else "seeds"
     with panel_style() as plt:
-        fig, axes = plt.subplots(1, 2, figsize=(9.0, 4.2), sharey=True, layout="constrained")
+        fig, axes = plt.subplots(1, 2, figsize=(10.0, 4.4), sharey=True, layout="constrained")
         colours = plt.get_cmap("tab20")
         for ax, key in zip(axes, SCENARIO_KEYS, strict=True):
             ax.set_title(TITLES[key], fontsize=FONT + 1)
@@ -75,9 +75,9 @@ def plot_power(curves: pd.DataFrame, plan: pd.DataFrame, stem: Path, title: str)
                           else "seeds (not priced: this run has no training benchmark)", fontsize=FONT)
             ax.tick_params(labelsize=FONT - 1)
         axes[0].set_ylabel("chance the claim's verdict settles (weakest part)", fontsize=FONT)
-        if drawn:
-            axes[1].legend(fontsize=FONT - 1, ncol=2, loc="lower right", title="claim (ring: this run)",
-                           title_fontsize=FONT - 1)
+        if drawn:  # beside the axes: inside, 20 claims would hide the curves
+            fig.legend(*axes[0].get_legend_handles_labels(), fontsize=FONT - 1, ncol=1 + len(drawn) // 12,
+                       loc="outside right upper", title="claim (ring: this run)", title_fontsize=FONT - 1)
         unplanned = [c for c in claims if c not in drawn]
         fig.suptitle(title + (f"\nnot plannable (fewer than 2 seeds with an effect): {', '.join(unplanned)}"
                               if unplanned else ""), fontsize=FONT + 1)
