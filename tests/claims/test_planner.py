@@ -148,7 +148,7 @@ def test_power_command_writes_its_tables_page_and_figure(tmp_path, capsys):
     k = int(plan["seeds_holds_at_2delta"].iloc[0])
     assert summary["seeds_holds_at_2delta"] == k and summary["undecided"] == 1 and summary["unplanned"] == 0
     assert summary["runs_holds_at_2delta"] == pytest.approx(k * 420 / (3 * 420))  # the run: 3 seeds' jobs
-    assert f"about {k} seeds" in summary["line"] and f"- {summary['line']}" in page
+    assert f"about {k} seeds" in summary["line"] and "its 1 inconclusive part if" in summary["line"] and f"- {summary['line']}" in page
     printed = capsys.readouterr().out
     assert "parts reach 80%" in printed and summary["line"] in printed
 

@@ -76,14 +76,19 @@ def _decider(plan_rows: pd.DataFrame, costs: RunCosts) -> tuple[float, float, fl
     """(seeds, CPU-hours, multiple of this run, words) of the design that settles every one of ``plan_rows`` in the
     scenario of an effect of twice delta: the most seeds any one of them needs."""
     k = plan_rows["seeds_holds_at_2delta"]
+    n = len(plan_rows)
+    parts = f"its {n} inconclusive part{'s' * (n > 1)}"
     if k.isna().any():
-        return np.nan, np.nan, np.nan, f"not within {MAX_SEEDS} seeds"
+        beyond = ", ".join(f"'{part}'" for part in plan_rows.loc[k.isna()].index.get_level_values("part"))
+        which = f"{beyond} ({int(k.isna().sum())} of {parts})" if n > 1 else parts
+        return np.nan, np.nan, np.nan, (f"no design of up to {MAX_SEEDS:,} seeds settles {which}, even at twice "
+                                        "delta: the spread between seeds dwarfs delta")
     seeds = int(k.max())
     hours = costs.design_hours(seeds)
     runs = hours * 3600 / costs.run_s if np.isfinite(hours) and costs.run_s > 0 else np.nan
     priced = (f" ({hours:.3g} CPU-hours here" + (f", {runs:.2g}x this run" if np.isfinite(runs) else "") + ")"
               if np.isfinite(hours) else "")
-    return seeds, hours, runs, f"about {seeds} seeds{priced}"
+    return seeds, hours, runs, f"about {seeds} seeds{priced} would settle {parts} if each effect were twice its delta"
 
 
 def claim_summary(plan: pd.DataFrame, claims: pd.DataFrame, recipe: pd.DataFrame, costs: RunCosts) -> pd.DataFrame:
@@ -105,14 +110,16 @@ def claim_summary(plan: pd.DataFrame, claims: pd.DataFrame, recipe: pd.DataFrame
         row.update(undecided=len(parts), unplanned=len(parts) - len(planned))
         words = f"{claim.claim}: recipe {verdict or 'not decided'}" + (f" ({row['recipe_parts']})"
                                                                         if row["recipe_parts"] else "")
-        if verdict == UNDECIDED and len(parts):
+        if verdict == UNDECIDED and not len(parts):
+            words += "; no deciding part is inconclusive: its parts' verdicts disagree"
+        elif verdict == UNDECIDED:
             if len(planned):
                 seeds, hours, runs, design = _decider(planned, costs)
                 row.update(seeds_holds_at_2delta=seeds, cpu_hours_holds_at_2delta=hours, runs_holds_at_2delta=runs)
-                words += (f"; if its {len(planned)} planned undecided part(s) had twice their delta, {design} "
-                          "would settle them")
+                words += f"; {design}"
             if row["unplanned"]:
-                words += f"; {row['unplanned']} undecided part(s) cannot be planned (see the table)"
+                words += (f"; {row['unplanned']} inconclusive part(s) cannot be planned (fewer than 2 seeds carry "
+                          "them)")
         row["line"] = words
         rows.append(row)
     return pd.DataFrame(rows, columns=CLAIM_SUMMARY_COLUMNS)
