@@ -14,6 +14,8 @@ from html.parser import HTMLParser
 TEXT_BLOCKS = {"p", "li", "td", "th", "dd", "dt", "figcaption", "h1", "h2", "h3", "h4", "h5", "h6", "summary"}
 VOID = {"area", "base", "br", "col", "embed", "hr", "img", "input", "link", "meta", "source", "track", "wbr"}
 LIST_MARKER = re.compile(r"^\s*(\d+\.|[-*+]) \S", re.M)
+# What an equation the build did not convert leaves in the text: a $ delimiter or a LaTeX command (\hat, \frac).
+LEFTOVER_TEX = re.compile(r"\$|\\[A-Za-z]{2,}")
 
 
 @dataclass
@@ -51,6 +53,8 @@ class PageProblems(HTMLParser):
             return
         if self._inside("article") and self._inside("p", "li") and (marker := LIST_MARKER.search(data)):
             self.problems.append(f"a list marker in running text: {data[marker.start():].strip()[:60]!r}")
+        if self._inside("article") and (tex := LEFTOVER_TEX.search(data)):
+            self.problems.append(f"LaTeX left unconverted: {data[max(0, tex.start() - 20):tex.end() + 20].strip()!r}")
 
 
 def page_problems(html_text: str) -> list[str]:

@@ -51,6 +51,12 @@ def test_the_checker_sees_an_equation_outside_every_block_and_a_list_marker_in_t
     assert len(problems) == 2 and "outside every paragraph" in problems[0] and "2. Intrinsic" in problems[1]
 
 
+def test_the_checker_sees_latex_the_build_left_unconverted():
+    assert page_problems(render("A skill of $1 - $ sse.\n")) != []  # a space before the closing $: not maths
+    assert page_problems(render("$$\\hat\\mu = \\bar y$$\n")) != []  # $$ is not the site's display maths
+    assert page_problems(render("A skill of $1 - s$ and\n\n```math\n\\hat\\mu\n```\n")) == []
+
+
 def test_a_display_equation_becomes_a_block_inside_its_list_item():
     out = render("1. The field:\n\n    ```math\n    E = \\frac{q}{r^2}\n    ```\n\n2. Next.\n")
     assert re.search(r'<li>.*<div class="math"><math [^>]*display="block">.*</li>', out, re.S), out
