@@ -271,8 +271,8 @@ def test_every_command_has_a_handler_and_the_docstring_lists_it():
     import efish.cli as cli
 
     commands = _commands(cli._parser())
-    assert len(commands) == 28 and "bench group" in commands and "bench scaling" in commands and "claims-by-stage" in commands and "compare-claims" in commands
-    assert "watch" in commands
+    assert len(commands) == 29 and "bench group" in commands and "bench scaling" in commands and "claims-by-stage" in commands and "compare-claims" in commands
+    assert "watch" in commands and "compare-runs" in commands
     for name, parser in commands.items():
         assert callable(parser.get_default("handler")), name
     usage = {" ".join(line.split()[1:3]) if line.split()[1] == "bench" else line.split()[1]

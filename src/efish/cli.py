@@ -5,6 +5,10 @@
     efish train [overrides] [--out D]         train one seed (checkpoint.pt, metrics.parquet, final.pt)
     efish watch RUN [--results D] [--interval S] [--once] [--plot F.png]   every training job of a run in a live
                                               table (update, return, entropy, KL, speed, ETA, state)
+    efish compare-runs RUN [RUN ...] [--sweep G --scale S --overrides O] [--results D] [--out F] [--plot F.png]
+                                              several runs' training curves on shared axes (each seed thin, the
+                                              mean over seeds thick) and each metric's final value with a 95% t
+                                              interval over seeds -> compare_runs.parquet|.csv, F.png and .pdf
     efish assay [overrides] --policy P...     run an assay into steps/episodes/food(/hidden).parquet
     efish schema steps|episodes|food|hidden|conditions   the columns of a rollout table and what they mean
     efish select --episodes F... --out D      rank seeds, write the ranking and the chosen seed
@@ -78,7 +82,7 @@ from pathlib import Path
 from typing import Sequence
 
 from ._version import __version__
-from .cli_claims import run_claims, run_claims_by_stage, run_compare_claims, run_power
+from .cli_claims import _sweep_runs, run_claims, run_claims_by_stage, run_compare_claims, run_power
 from .cli_support import HelpFormatter, add_command, add_overrides, run_of, see_docs, write_metadata
 from .config import ConfigError, compose, to_yaml
 from .figures.gallery import GALLERY, MAX_WIDTH_PX
@@ -170,7 +174,8 @@ def _config_commands(sub: argparse._SubParsersAction) -> None:
 
 
 def _training_commands(sub: argparse._SubParsersAction) -> None:
-    """Training a seed, watching the runs train, ranking and stacking the seeds: train, watch, select, stack-seeds."""
+    """Training a seed, watching the runs train and comparing them, ranking and stacking the seeds: train, watch,
+    compare-runs, select, stack-seeds."""
     tr = add_command(sub, "train", "train one seed with recurrent MAPPO",
                      "Train one seed with recurrent MAPPO on the paper's sampled training arenas (policy=foraging is "
                      "composed before the overrides), resuming from a checkpoint in --out. Writes checkpoint.pt, "
@@ -192,6 +197,7 @@ def _training_commands(sub: argparse._SubParsersAction) -> None:
                     help="also write return, entropy and KL against env steps, one line per job, to this PNG "
                          "(rewritten at every refresh)")
     wa.set_defaults(handler=_watch)  # no overrides: nothing to compose
+    _compare_runs_command(sub)
     sel = add_command(sub, "select", "rank seeds by their selection episodes and choose one",
                       "Rank the trained seeds by their selection episodes and choose the seed the assays act with. "
                       "Writes ranking.parquet, selected_seed.txt, config.yaml and provenance.json to --out.",
@@ -210,6 +216,32 @@ def _training_commands(sub: argparse._SubParsersAction) -> None:
     st.add_argument("--ranking", type=Path, required=True, help=f"the seed ranking ({RANKING})")
     _add_out(st, "the stacked table (.parquet)", required=True)
     st.set_defaults(handler=_stack_seeds)
+
+
+def _compare_runs_command(sub: argparse._SubParsersAction) -> None:
+    """``efish compare-runs``: several runs' training curves on shared axes, and their final values."""
+    cr = add_command(sub, "compare-runs", "several runs' training curves on shared axes, with their final values",
+                     "Read the foraging seeds' metrics.parquet of each run (with --sweep, a sweep's runs), smooth each "
+                     "seed's curve of every metric over its last 10 finite values (as efish watch smooths the return) "
+                     "and print, per run and metric, the seeds' final values: their mean with a 95% t interval over "
+                     "the seeds (none with one seed). Policy recipes (train/homing) are left out. Writes the table "
+                     "(--out) and the curves against env steps, one panel per metric, each seed thin and the mean "
+                     "over seeds thick, one colour per run (--plot) when asked.",
+                     "docs/tutorials/watch-a-run.md#compare-runs", "docs/tutorials/sweep-a-parameter.md")
+    cr.add_argument("runs", nargs="*", metavar="RUN",
+                    help="a run name under --results (smoke, laptop-453280a3) or a run's folder (one holding train/); "
+                         "one or more in all, with --sweep's")
+    cr.add_argument("--sweep", help="also every run of this sweep, in grid order: the grid given to the workflow's "
+                                    "--config sweep= (inline or a YAML file), with --scale and --overrides")
+    cr.add_argument("--scale", help="the sweep's scale (--config scale=; default: the workflow's)")
+    cr.add_argument("--overrides", default="", help="the sweep's run overrides (--config overrides=)")
+    cr.add_argument("--results", type=Path, default=RESULTS_ROOT,
+                    help="where a run name's folder is (default results/)")
+    _add_out(cr, "write the table (run, metric, seeds, final_mean, ci_low, ci_high, env_steps) as .parquet or .csv; "
+                 "a folder gets compare_runs.parquet")
+    cr.add_argument("--plot", type=Path, metavar="F.png", help="draw the curves to this PNG, and the same as .pdf "
+                                                                "beside it")
+    cr.set_defaults(handler=_compare_runs)  # no Hydra overrides: nothing to compose
 
 
 def _assay_commands(sub: argparse._SubParsersAction) -> None:
@@ -579,6 +611,12 @@ def _watch(args, cfg, started) -> None:
         pass
 
 
+def _compare_runs(args, cfg, started) -> None:
+    from .compare_runs import compare_runs
+
+    compare_runs([*args.runs, *(_sweep_runs(args) if args.sweep else [])], args.results, args.out, args.plot)
+
+
 def _assay(args, cfg, started) -> None:
     from .rl.policy import load_policy
     from .rollout.assay import run_assay_group
@@ -911,7 +949,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     logging.basicConfig(level=logging.INFO, format="efish: %(message)s", stream=sys.stderr)
     started = datetime.now(timezone.utc)
     try:
-        cfg = compose([*_recipe_override(args), *args.overrides]) if "overrides" in args else None
+        # a command's Hydra overrides are a list; compare-claims' and compare-runs' --overrides is a sweep's string
+        composes = isinstance(getattr(args, "overrides", None), list)
+        cfg = compose([*_recipe_override(args), *args.overrides]) if composes else None
         args.handler(args, cfg, started)
     except (ConfigError, ValueError, OSError) as exc:
         print(f"efish: error: {exc}", file=sys.stderr)

@@ -61,7 +61,7 @@ def training_jobs(run: Run) -> list[Job]:
         raise ValueError(f"no run folder {run.results}: name a run under --results (efish watch smoke)")
     planned = planned_updates(run.name)
     folders = {p.name: p for p in run.results.glob(training_folder("*")) if p.is_dir()}
-    names = sorted(set(planned) | set(folders), key=_job_order)
+    names = sorted(set(planned) | set(folders), key=job_order)
     if not names:
         raise ValueError(f"{run.path(training_folder(''))} holds no training jobs (seed_N or policy folders) yet")
     updates = {name: planned[name] if name in planned else _recipe_updates(run.name, name) for name in names}
@@ -94,10 +94,16 @@ def _is_shipped_scale(run_name: str) -> bool:
     return (config_dir() / "scale" / f"{run_name}.yaml").is_file()
 
 
-def _job_order(name: str) -> tuple:
-    """Seeds first, by number; then the other folders by name."""
+def is_seed(name: str) -> bool:
+    """Whether a job folder is a foraging seed's (``seed_3``), not a policy recipe's (``homing``)."""
     number = name.removeprefix(seed_name(""))
-    return (0, int(number), "") if name.startswith(seed_name("")) and number.isdigit() else (1, 0, name)
+    return name.startswith(seed_name("")) and number.isdigit()
+
+
+def job_order(name: str) -> tuple:
+    """The sort key of job folders: seeds first, by number (seed_2 before seed_10); then the other folders by
+    name."""
+    return (0, int(name.removeprefix(seed_name(""))), "") if is_seed(name) else (1, 0, name)
 
 
 def read_metrics(job: Job) -> pd.DataFrame | None:
@@ -129,12 +135,33 @@ def job_row(job: Job, metrics: pd.DataFrame | None, now: float) -> dict:
     age = max(0.0, now - metrics.attrs.get("written", now))  # a clock a little behind the file server's
     return {"job": job.name, "state": FINISHED if finished else RUNNING, "update": f"{update}/{_or_unknown(total)}",
             "env steps": f"{int(last['env_steps']):,}",
-            SMOOTHED: f"{returns.tail(RETURN_WINDOW).mean():.3f}" if len(returns) else "-",
+            SMOOTHED: f"{window_mean(returns):.3f}" if len(returns) else "-",
             "last return": f"{returns.iloc[-1]:.3f}" if len(returns) else "-",
             "entropy": f"{last['entropy']:.3f}", "KL": f"{last['approx_kl']:.2g}",
             "env-steps/s": f"{last['env_steps_per_s']:,.0f}",
             "ETA": _eta(finished, total, update, int(last["env_steps"]) / update, rate),
             "last update": f"{duration(age)} ago"}
+
+
+def smoothed(values: pd.Series, window: int = RETURN_WINDOW) -> pd.Series:
+    """A curve smoothed as the table's return is: at each finite value, the mean of the last ``window`` finite
+    values up to it (fewer at the start). NaN (an update where no episode ended has no return) is left out, not
+    counted as 0; the index (update or env steps) is kept.
+
+    >>> smoothed(pd.Series([1.0, float("nan"), 3.0, 5.0]), window=2).tolist()
+    [1.0, 2.0, 4.0]
+    """
+    return values.dropna().rolling(window, min_periods=1).mean()
+
+
+def window_mean(values: pd.Series, window: int = RETURN_WINDOW) -> float:
+    """The mean of the last ``window`` finite values (NaN where there is none): the table's smoothed return, and
+    where a smoothed curve ends (:func:`smoothed`).
+
+    >>> window_mean(pd.Series([1.0, 2.0, 3.0, float("nan")]), window=2)
+    2.5
+    """
+    return float(values.dropna().tail(window).mean())
 
 
 def _total_updates(metrics: pd.DataFrame, job: Job, finished: bool) -> int | None:
@@ -193,12 +220,16 @@ def curve_columns(metrics: dict[str, pd.DataFrame | None]) -> list[str]:
 def task_groups(names: list[str]) -> dict[str, list[str]]:
     """Jobs grouped by task, each group drawn on its own axes: the foraging seeds together, each policy recipe
     (homing: another task, another reward scale) alone."""
-    seeds = [n for n in names if _job_order(n)[0] == 0]
+    seeds = [n for n in names if is_seed(n)]
     return {**({"foraging seeds": seeds} if seeds else {}), **{n: [n] for n in names if n not in seeds}}
 
 
-def _steps(value: float, _position=None) -> str:
-    """An env-step tick label short enough not to overlap: 80k, 1.2M."""
+def steps_label(value: float, _position=None) -> str:
+    """An env-step tick label short enough not to overlap (a matplotlib ``FuncFormatter``'s function).
+
+    >>> steps_label(80_000), steps_label(1_200_000), steps_label(400)
+    ('80k', '1.2M', '400')
+    """
     for scale, suffix in ((1e6, "M"), (1e3, "k")):
         if abs(value) >= scale:
             return f"{value / scale:g}{suffix}"
@@ -231,7 +262,7 @@ def plot_curves(metrics: dict[str, pd.DataFrame | None], path: Path, title: str 
                         ax.plot(points["env_steps"], points[column], lw=1, color=colours[name], label=name)
                 ax.set_title(f"{group}: {CURVE_LABELS.get(column, column)}", fontsize=7)
                 ax.set_xlabel("env steps")
-                ax.xaxis.set_major_formatter(FuncFormatter(_steps))
+                ax.xaxis.set_major_formatter(FuncFormatter(steps_label))
             for ax in block[len(columns):]:
                 ax.axis("off")
             if any(ax.lines for ax in block):
