@@ -20,9 +20,9 @@ import efish
 PACKAGE = Path(efish.__file__).resolve().parent
 LAYERS = {
     "__init__": 0, "_version": 0, "_numba_cache": 0, "_jit": 0, "io": 0, "config": 0, "layout": 0, "units": 0,
-    "drawing": 0,
+    "drawing": 0, "senses": 0,
     "physics": 1, "sensors": 2, "env": 3, "rl": 4, "rollout": 5, "analysis": 6, "claims": 7, "figures": 8,
-    "bench": 9, "cli": 9, "cli_claims": 9, "cli_support": 9, "run_plan": 9, "share": 9, "sweep": 9, "watch": 9,
+    "bench": 9, "cli": 9, "compare_runs": 9, "cli_claims": 9, "cli_support": 9, "run_plan": 9, "share": 9, "sweep": 9, "watch": 9,
     "__main__": 10,
 }
 

@@ -12,12 +12,13 @@ import numpy as np
 import pandas as pd
 from scipy import stats as sps
 
+from ..senses import SENSES, error_column
 from ..units import wrap
 from ._tables import AGENT_EPISODE, DEFAULTS, nan_frame, or_nan_row, require
 from .stats import mann_whitney, spearman
 
-#: Receptor class -> error-angle column of the steps table.
-ERROR_COLUMNS = {"morm": "err_morm_rad", "amp": "err_amp_rad", "knollen": "err_knollen_rad"}
+#: Receptor class (its short spelling, the ``channel``) -> error-angle column of the steps table.
+ERROR_COLUMNS = {sense.short: error_column(sense) for sense in SENSES}
 SHAPE_MEASURES = ("tortuosity", "curvature_rad_per_cm", "path_length_cm", "n_steps")
 #: Columns of :func:`alignment_episodes` (docs/methods/analyses.md#analysis-homing).
 ALIGNMENT_COLUMNS = [*AGENT_EPISODE, "channel", "success", "n_steps", "aligned_fraction", "straight_aligned_fraction",

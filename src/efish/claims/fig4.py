@@ -19,13 +19,15 @@ import numpy as np
 import pandas as pd
 
 from ..layout import analysis_table
+from ..senses import SENSES, condition_name
 from .context import Context, claim
 from .parts import ceiling, mann_whitney_part, paired_part, present, spearman_part
 from .statistics import excess_theil_per_episode, welch_difference
 from .verdicts import Outcome, Part
 
-# ablation conditions are named by the receptor classes left on (config/assay/ablation4.yaml)
-ALL_ON, M_OFF, A_OFF, K_OFF = "M_A_K", "A_K", "M_K", "M_A"
+# ablation conditions are named by the receptor classes left on (config/assay/ablation4.yaml): all on, then each off
+ALL_ON = condition_name(SENSES)
+M_OFF, A_OFF, K_OFF = (condition_name(s for s in SENSES if s is not off) for off in SENSES)
 FOOD = "food_total"
 
 

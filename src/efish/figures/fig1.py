@@ -13,15 +13,16 @@ import pandas as pd
 
 from .. import layout
 from ..config.schema import AnalysisConfig, EnvConfig, SensorsConfig
+from ..senses import SENSES
 from . import schematics as sk
 from .panel import Panel
 from .style import FIELD_CMAP, HEATMAP_CMAP, NEUTRAL_COLOUR, PELLET_COLOUR, RECEPTOR_COLOURS, agent_colour, missing
 
-RECEPTOR_LABELS = {"mormyromast": "Mormyromast", "ampullary": "Ampullary", "knollenorgan": "Knollenorgan"}
+RECEPTOR_LABELS = {s.name: s.label for s in SENSES}
 TARGET_STYLES = {"agent": "-", "pellet": "--"}
 #: Sensor rings of panel F, cm outside the body circle: the classes share the circle, drawn apart to be seen.
 SENSOR_RINGS_CM = {"mormyromast": 0.0, "ampullary": 0.25, "knollenorgan": 0.5}
-SENSOR_MARKERS = {"mormyromast": "o", "ampullary": "s", "knollenorgan": "^"}
+SENSOR_MARKERS = {s.name: s.marker for s in SENSES}
 TRAIL_STEPS = 40  # panel H: steps of path drawn behind each agent
 
 

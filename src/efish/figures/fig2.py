@@ -12,6 +12,7 @@ import numpy as np
 import pandas as pd
 
 from .. import layout
+from ..senses import SENSES
 from .panel import Panel
 from .style import RECEPTOR_COLOURS, condition_palette, finite, missing, stars_for
 
@@ -20,10 +21,10 @@ CONDITIONS = ("electric", "raycast")
 CONDITION_STYLE = {"electric": "-", "raycast": "--"}
 MAX_EPISODES_DRAWN = 8
 #: error-angle channel of the analysis tables -> receptor class of the style palette
-CHANNEL_RECEPTOR = {"morm": "mormyromast", "amp": "ampullary", "knollen": "knollenorgan"}
+CHANNEL_RECEPTOR = {s.short: s.name for s in SENSES}
 #: the target's intrinsic and EOD dipoles share its axis, so the Ampullary and Knollenorgan error angles nearly
 #: coincide: distinct dashes and markers keep both lines visible where they overlap
-CHANNEL_STYLE = {"morm": ("-", "o"), "amp": ("--", "s"), "knollen": (":", "^")}
+CHANNEL_STYLE = {s.short: (s.line, s.marker) for s in SENSES}
 
 
 def _palette() -> dict:

@@ -20,9 +20,10 @@ from ..config.schema import AnalysisConfig, EfishConfig
 from ..drawing import AGENT_COLOURS as AGENT_COLOURS  # the arena's colours: shared with the live env's render
 from ..drawing import PELLET_COLOUR as PELLET_COLOUR
 from ..drawing import agent_colour as agent_colour
+from ..senses import SENSES
 from .panel import conditions_key, settings_key
 
-RECEPTOR_COLOURS = {"mormyromast": "#0072B2", "ampullary": "#009E73", "knollenorgan": "#D55E00"}
+RECEPTOR_COLOURS = {sense.name: sense.colour for sense in SENSES}
 SELECTED_COLOUR = "#D55E00"
 NEUTRAL_COLOUR = "#7f7f7f"
 #: The control (first) condition of an assay is always grey; the others take CONDITION_COLOURS in order.

@@ -31,6 +31,7 @@ from ..env.vec_env import VecEnv
 from ..physics.fields import coulomb_constant, pairwise_dipole_field, pairwise_monopole_field
 from ..physics.plan import EffectPlan
 from ..physics.reference import eod_monopoles, intrinsic_moments
+from ..senses import SENSES, error_column
 from ..units import CM, wrap
 from .measure_kernels import (
     FieldConstants,
@@ -144,7 +145,7 @@ def homing_errors(env: VecEnv) -> dict[str, np.ndarray]:
     shape = s.heading.shape
     target = getattr(env.task, "target", None)
     if target is None or not target.any():
-        return {f"err_{c}_rad": np.full(shape, np.nan) for c in ("morm", "amp", "knollen")}
+        return {error_column(sense): np.full(shape, np.nan) for sense in SENSES}
     t = int(np.flatnonzero(target)[0])
     xy, h = s.xy * CM, s.heading
     txy, th = xy[:, t:t + 1], h[:, t:t + 1]                           # [B, 1, 2], [B, 1]
@@ -155,10 +156,10 @@ def homing_errors(env: VecEnv) -> dict[str, np.ndarray]:
     p_induced = plan.alpha_agent * eod_field(plan, soft, xy, h, txy)   # each homer's EOD at the target
     e_morm = pairwise_dipole_field(xy, txy, p_induced, **field)
     out = {}
-    for name, e in (("morm", e_morm), ("amp", e_amp), ("knollen", e_knollen)):
+    for sense, e in zip(SENSES, (e_morm, e_amp, e_knollen), strict=True):
         err = wrap(h - angle_of(e))
         err[:, t] = np.nan
-        out[f"err_{name}_rad"] = err
+        out[error_column(sense)] = err
     return out
 
 

@@ -37,11 +37,12 @@ from ..physics.images import image_sources
 from ..physics.plan import EffectPlan, Scene, build_plan
 from ..physics.reference import eod_monopoles
 from ..physics.snapshot import Snapshot, SnapshotBatch
+from ..senses import SENSES
 from ..sensors.sense import raw_readings
 from ..units import CM
 
 F64, B, S = pa.float64(), pa.bool_(), pa.string()
-RECEPTORS = ("mormyromast", "ampullary", "knollenorgan")
+RECEPTORS = tuple(s.name for s in SENSES)
 
 # (name, type, one-line description): the one declaration of every column of a scene table
 COLUMNS = [
