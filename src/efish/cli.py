@@ -441,7 +441,8 @@ def _cluster_commands(sub: argparse._SubParsersAction) -> None:
     pc.add_argument("--results", type=Path, help="results folder of that run (default results/<--from>)")
     pc.add_argument("--profile", type=Path, default=Path("workflow/profiles/slurm"),
                     help="the Snakemake profile whose resources are checked (default workflow/profiles/slurm)")
-    pc.add_argument("--dry-run", type=Path, help="a saved `snakemake -n --forceall` output instead of running it")
+    pc.add_argument("--dry-run", type=Path, metavar="FILE",
+                    help="a saved `snakemake -n --forceall` output to read instead of running the dry run")
     _add_json(pc)
     pc.add_argument("--suggest", action="store_true", help="also print set-resources covering the headroom")
     pc.set_defaults(handler=_plan_cluster)
@@ -480,11 +481,17 @@ BENCH_STUDIES = {
 }
 
 
-def _bench_command(bsub: argparse._SubParsersAction, name: str, *docs: str) -> argparse.ArgumentParser:
-    """``efish bench <name>`` with its help (:data:`BENCH_STUDIES`) and overrides, citing its Benchmarks section."""
+def _bench_command(bsub: argparse._SubParsersAction, name: str, *docs: str, sized: bool = True
+                   ) -> argparse.ArgumentParser:
+    """``efish bench <name>`` with its help (:data:`BENCH_STUDIES`) and overrides, citing its Benchmarks section;
+    ``sized``: the study runs work of the bench.* sizes (a finished run's timing does not: its overrides name the
+    run)."""
     summary, description = BENCH_STUDIES[name]
     parser = add_command(bsub, name, summary, description, f"docs/benchmarks.md#{name}", *docs)
-    add_overrides(parser, example="scale=smoke bench.repeats=3", note="the bench.* fields are the study's sizes")
+    if sized:
+        add_overrides(parser, example="scale=smoke bench.repeats=3", note="the bench.* fields are the study's sizes")
+    else:
+        add_overrides(parser, example="scale=laptop", note="they name the run")
     return parser
 
 
@@ -525,7 +532,7 @@ def _bench_parsers(sub: argparse._SubParsersAction) -> None:
     bg.add_argument("--episodes", type=int, help="episodes per policy (default bench.group_episodes)")
     bg.add_argument("--steps", type=int, help="steps per episode (default bench.group_steps)")
     bg.set_defaults(handler=_bench_group)
-    bpl = _bench_command(bsub, "pipeline")
+    bpl = _bench_command(bsub, "pipeline", sized=False)
     bpl.add_argument("--results", type=Path, help="results folder of the run (default results/{run})")
     _add_json(bpl)
     bpl.set_defaults(handler=_bench_pipeline)
