@@ -14,7 +14,9 @@ from efish.layout import (
     Run,
     analysis_table,
     assay_table,
+    parse_recipe_draw,
     parse_table,
+    recipe_draw,
     seed_name,
     stacked_seeds_table,
     training_file,
@@ -34,6 +36,12 @@ def test_names_and_their_parse_agree():
                                                                              "theil")
     assert parse_table(stacked_seeds_table("wide2")) == ("seeds", "wide2", "", "episodes")
     assert parse_table(training_file(seed_name(3), "metrics.parquet")) is None
+    # a policy recipe's draws (scale.homing_seeds): draw 1 is the recipe's own folder
+    assert [recipe_draw("homing_raycast", k) for k in (1, 2, "{draw}")] == [
+        "homing_raycast", "homing_raycast_draw_2", "homing_raycast_draw_{draw}"]
+    for name in ("homing", "homing_draw_2", "homing_raycast_draw_12"):
+        assert recipe_draw(*parse_recipe_draw(name)) == name
+    assert parse_recipe_draw("homing_draw_1") == ("homing_draw_1", 1)  # draw 1 is never spelt so
 
 
 def test_a_run_and_its_top_seeds_share_one_layout():

@@ -6,12 +6,14 @@ its tables under ``results/<run>/`` and its drawings under ``figures/<run>/``::
     results/<run>/
       train/<seed_N | policy>/        final.pt, metrics.parquet, stage_K.pt (training); metrics.csv, tensorboard/
                                       (its live logs, efish.rl.loggers)
+      train/<policy>_draw_K/          the same for the K-th draw of a policy recipe (K >= 2, scale.homing_seeds)
       selection/seed_N/               episodes, steps, food (held-out patchy episodes)
       analysis/selection/             ranking.parquet, selected_seed.txt
       assays/<assay>/                 steps, episodes, food, conditions (, hidden) .parquet
       analysis/<analysis>/<assay>/    the tables of efish.analysis.registry, analysis_settings.parquet
       seeds/<assay>/episodes.parquet  the top seeds' episodes stacked (supplement)
-      seeds/seed_N/                   another top seed's assays, analyses and claims, same layout
+      seeds/seed_N/                   another top seed's assays, analyses and claims, same layout (the K-th
+                                      top seed's homing with the K-th draw of the homing recipes)
       seeds/groups/<assay>/seed_N/    while a run lasts: the top seeds' reruns of an assay, rolled out in one job
       learning/stage_K/               the same for the selected seed's K-th kept training stage
       learning/                       claims_by_stage, claims_trends .parquet, claims.md (claims along training)
@@ -96,6 +98,31 @@ def training_folder(name: str) -> str:
 def training_file(name: str, file: str) -> str:
     """``train/<name>/<file>``: ``name`` is a seed's folder (:func:`seed_name`) or a policy recipe."""
     return f"{training_folder(name)}/{file}"
+
+
+#: Between a policy recipe's name and the number of its draw in the draw's training folder (:func:`recipe_draw`).
+DRAW = "_draw_"
+
+
+def recipe_draw(recipe: str, k: int | str) -> str:
+    """The training folder's name of the k-th independent draw of policy recipe ``recipe`` (``train.seed =
+    scale.seed_offset + k``): draw 1 is the recipe's own folder, a later one ``homing_draw_2`` (``{policy}_draw_{draw}``
+    in a rule).
+
+    >>> recipe_draw("homing", 1), recipe_draw("homing_raycast", 3)
+    ('homing', 'homing_raycast_draw_3')
+    """
+    return recipe if str(k) == "1" else f"{recipe}{DRAW}{k}"
+
+
+def parse_recipe_draw(name: str) -> tuple[str, int]:
+    """The recipe and the draw of a recipe's training folder: the inverse of :func:`recipe_draw`.
+
+    >>> parse_recipe_draw("homing_raycast_draw_3"), parse_recipe_draw("homing")
+    (('homing_raycast', 3), ('homing', 1))
+    """
+    recipe, _, k = name.rpartition(DRAW)
+    return (recipe, int(k)) if recipe and k.isdigit() and int(k) >= 2 else (name, 1)
 
 
 def stage_name(k: int | str) -> str:

@@ -6,7 +6,8 @@ its answers into rule definitions, wildcard constraints and shell lines. The pla
 - the run that ``--config`` asks for (scale, overrides, folder name), with one-line errors (:class:`PlanError`);
 - which assays the scale runs, which other assay files may be asked for, and which policies each assay's
   conditions act with, every condition checked before any job runs (:func:`checked_policies`, cached);
-- what the other top seeds and the training stages rerun for their own claims;
+- what the other top seeds and the training stages rerun for their own claims, and the draws of the homing
+  recipes the top seeds rerun homing with (``scale.homing_seeds``);
 - the kept training stages (:class:`Stages`);
 - the panels the scale draws, grouped by figure as ``efish.figures.registry`` groups them;
 - the targets of ``rule all``.
@@ -55,6 +56,8 @@ from .layout import (
     assay_table,
     bench_file,
     claims_by_stage_stem,
+    parse_recipe_draw,
+    recipe_draw,
     seed_name,
     stacked_seeds_table,
     training_file,
@@ -290,6 +293,7 @@ class RunPlan:
             settings.setdefault(name, composed([*base, f"assay={name}"]).assay)
         plan = cls(scale, overrides, run, cfg, assays, asked, recipes, settings, policies)
         plan.check_groups()
+        plan.check_draws()
         return plan
 
     # -------------------------------------------------------------- the run
@@ -379,7 +383,8 @@ class RunPlan:
     def seed_claim_assays(self) -> list[str]:
         """The assays each other top seed (and each training stage) reruns for its own claims: every assay of the
         scale that some claim reads and whose conditions act, at least in part, with the selected policy. An
-        assay acted only by recipes (homing) gives the same tables for every seed: its claims are not rerun."""
+        assay acted only by recipes (homing) gives the same tables for every seed: a stage does not rerun it, and a
+        top seed only with a draw of those recipes of its own (:attr:`drawn_assays`)."""
         return [name for name in self.assays if SELECTED in self.assay_policies[name] and self.claims_read([name])]
 
     @functools.cached_property
@@ -387,10 +392,18 @@ class RunPlan:
         """The tables the claims read among those the rerun assays write (a top seed's, a stage's claims)."""
         return self.claims_read(self.seed_claim_assays)
 
-    def seed_analysis_assays(self, analysis: Analysis) -> list[str]:
-        """The rerun assays whose ``analysis`` tables some claim reads (only those analyses are rerun)."""
-        return [name for name in self.seed_claim_assays
-                if any(analysis_table(analysis.name, name, t) in self.seed_claim_tables for t in analysis.outputs)]
+    def seed_analysis_assays(self, analysis: Analysis, assays: Sequence[str] | None = None) -> list[str]:
+        """The rerun assays (``assays``; default :attr:`seed_claim_assays`, a training stage's) whose ``analysis``
+        tables some claim reads (only those analyses are rerun)."""
+        assays = self.seed_claim_assays if assays is None else list(assays)
+        tables = self.claims_read(assays)
+        return [name for name in assays
+                if any(analysis_table(analysis.name, name, t) in tables for t in analysis.outputs)]
+
+    def top_seed_analysis_assays(self, analysis: Analysis) -> list[str]:
+        """:meth:`seed_analysis_assays` of a top seed's copy: the claims' assays it reruns, homing included where
+        some top seed reruns it with a draw of the homing recipes."""
+        return self.seed_analysis_assays(analysis, [*self.seed_claim_assays, *self.drawn_assays])
 
     @property
     def top_seed_assays(self) -> list[str]:
@@ -418,6 +431,70 @@ class RunPlan:
             if not assay.deterministic:
                 raise PlanError(f"assay {name}: the top seeds rerun it as one group, which needs "
                                 f"assay.deterministic=true")
+
+    # -------------------------------------------------------------- the homing recipes' draws
+    @functools.cached_property
+    def recipe_claim_assays(self) -> list[str]:
+        """The scale's assays that some claim reads and whose conditions act with policy recipes only (homing): the
+        same tables for every foraging seed, so a top seed reruns them only with a draw of those recipes of its
+        own (``scale.homing_seeds``)."""
+        return [name for name in self.assays
+                if SELECTED not in self.assay_policies[name] and self.claims_read([name])]
+
+    @functools.cached_property
+    def drawn_recipes(self) -> list[str]:
+        """The recipes :attr:`recipe_claim_assays` act with (homing, homing_raycast): each is drawn
+        ``scale.homing_seeds`` times."""
+        return sorted({p for name in self.recipe_claim_assays for p in self.assay_policies[name]} - {SELECTED})
+
+    @property
+    def draws(self) -> tuple[int, ...]:
+        """The draws k = 2..``scale.homing_seeds`` of the homing recipes (draw 1 is the run's own): the k-th top
+        seed reruns :attr:`recipe_claim_assays` with draw k. None where no claim's assay acts with recipes alone."""
+        return tuple(range(2, self.cfg.scale.homing_seeds + 1)) if self.drawn_recipes else ()
+
+    @property
+    def drawn_assays(self) -> list[str]:
+        """The assays the top seeds of :meth:`draw_seeds` rerun solo, each with its own draw of the recipes."""
+        return list(self.recipe_claim_assays) if self.draws else []
+
+    @property
+    def draw_trainings(self) -> list[str]:
+        """The training folder of every draw k >= 2 of every drawn recipe (``homing_draw_2``, ...), draw by draw."""
+        return [recipe_draw(recipe, k) for k in self.draws for recipe in self.drawn_recipes]
+
+    def draw_args(self, k: int) -> str:
+        """:attr:`args` for training the k-th draw of a policy recipe: :attr:`policy_args` for draw 1 (the run's
+        own), the seed ``seed_offset + k`` for a later one."""
+        if k == 1:
+            return self.policy_args
+        return " ".join([self.args, shlex.quote(f"train.seed={self.cfg.scale.seed_offset + k}")])
+
+    def recipe_training(self, folder: str) -> tuple[str, str]:
+        """(recipe, args) of the train_policy job of training folder ``folder``: a recipe of ``config/policy/``
+        (draw 1) or one of :attr:`draw_trainings`."""
+        recipe, k = parse_recipe_draw(folder)
+        return recipe, self.draw_args(k)
+
+    def draw_seeds(self, top: Sequence[int]) -> dict[int, int]:
+        """Top seed -> the draw of the homing recipes it reruns :attr:`drawn_assays` with: the k-th of ``top`` (best
+        first, the selected seed first) reruns them with draw k, k = 2..``scale.homing_seeds``; a top seed beyond
+        those does not rerun them (its homing parts are not run)."""
+        return {seed: k for k, seed in enumerate(top, start=1) if k in self.draws}
+
+    def top_seed_claim_tables(self, drawn: bool) -> list[str]:
+        """The tables a top seed's claims read in its copy: :attr:`seed_claim_tables`, and those of
+        :attr:`drawn_assays` where it reruns them (``drawn``: it is one of :meth:`draw_seeds`)."""
+        return self.claims_read([*self.seed_claim_assays, *self.drawn_assays]) if drawn else self.seed_claim_tables
+
+    def check_draws(self) -> None:
+        """A :class:`PlanError` for more draws of the homing recipes than top seeds to rerun homing with them (a
+        scale without a claim's assay acted by recipes alone ignores ``scale.homing_seeds``)."""
+        scale = self.cfg.scale
+        if self.drawn_recipes and scale.homing_seeds > max(1, scale.top_seeds):
+            raise PlanError(f"scale.homing_seeds={scale.homing_seeds} exceeds scale.top_seeds={scale.top_seeds}: the "
+                            f"k-th top seed reruns homing with the k-th draw of its recipes, so set "
+                            f"scale.homing_seeds at most {max(1, scale.top_seeds)}")
 
     # -------------------------------------------------------------- figures
     @functools.cached_property
@@ -452,10 +529,13 @@ class RunPlan:
         return [str(run.clip(name)) for name in self.clip_assays] + [str(run.contact_sheet)]
 
     def training_targets(self, run: Run) -> list[str]:
-        """Every policy the run trains: each seed's final.pt and that of each recipe the scale's assays act with (in
-        ``rule all``: a sweep's point that copies its training gets all of it, as if it had trained)."""
+        """Every policy the run trains: each seed's final.pt, that of each recipe the scale's assays act with and
+        that of each later draw of the homing recipes (in ``rule all``: a sweep's point that copies its training
+        gets all of it, as if it had trained; and the draws train beside the seeds, not after the seed selection
+        that the top seeds' reruns wait for)."""
         recipes = sorted({p for name in self.assays for p in self.assay_policies[name]} - {SELECTED})
-        return [str(run.path(training_file(name, "final.pt"))) for name in [*map(seed_name, self.seeds), *recipes]]
+        return [str(run.path(training_file(name, "final.pt")))
+                for name in [*map(seed_name, self.seeds), *recipes, *self.draw_trainings]]
 
     def targets(self, run: Run) -> list[str]:
         """Every final output of the pipeline for ``run``: the default target."""

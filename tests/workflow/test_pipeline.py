@@ -11,6 +11,7 @@ import subprocess
 import time
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 
@@ -129,6 +130,8 @@ def test_overrides_reach_every_efish_call(tmp_path):
     (["overrides=scale.assays=[nope]"], [], "unknown assay 'nope'"),
     (["overrides=scale.keep_stages=[]"], ["learning"], "the learning target needs scale.keep_stages"),
     (["overrides=scale.learning=true scale.keep_stages=[]"], [], "learning=true needs scale.keep_stages"),
+    (["overrides=scale.homing_seeds=2"], [], "efish workflow: scale.homing_seeds=2 exceeds scale.top_seeds=1"),
+    (["overrides=scale.homing_seeds=0"], [], "efish config: scale.homing_seeds=0 is out of range"),
 ])
 def test_bad_input_fails_before_any_job(tmp_path, config, target, message):
     result = dry_run(tmp_path, *target, "--config", "scale=smoke", *config)
@@ -232,8 +235,97 @@ def test_one_job_rolls_out_every_top_seed_that_reruns_an_assay(tmp_path):
     assert jobs["top_seed_group"] == 12 and jobs["top_seed_assay"] + jobs["top_seed_assay_with_hidden"] == 39
     calls = [line for line in result.stdout.splitlines() if line.startswith("Shell command: efish assay")
              and "/seeds/" in line]
-    assert len(calls) == 12 and all(" --group 3=" in call or " --group 1=" in call for call in calls)
+    grouped = [call for call in calls if " --group " in call]
+    assert len(grouped) == 12 and all(" --group 3=" in call or " --group 1=" in call for call in grouped)
+    # homing, acted by two recipes, is rerun solo by the 2nd and 3rd top seeds (scale.homing_seeds: the test below)
+    assert [" assay=homing " in call for call in calls if call not in grouped] == [True, True]
     assert len(re.findall(r"^Shell command: \(ln -fv results/laptop/seeds/groups/", result.stdout, flags=re.M)) == 39
+
+
+#: The jobs scale.homing_seeds = 3 (the laptop scale's) adds to one draw of the homing recipes: both recipes trained
+#: again for draws 2 and 3, and the 2nd and 3rd top seeds' homing (which records hidden states), each with the two
+#: analyses the homing claims read (homing's and dynamics').
+DRAW_JOBS = {"train_policy": 4, "top_seed_recipe_assay_with_hidden": 2, "top_seed_analysis_homing": 2,
+             "top_seed_analysis_dynamics": 2}
+
+
+def test_the_top_seeds_rerun_homing_each_with_its_own_draw_of_the_homing_recipes(tmp_path):
+    """The laptop scale decides the homing claims over scale.homing_seeds = 3 draws of the homing recipes: draw k
+    >= 2 trains homing and homing_raycast again with train.seed k into train/<recipe>_draw_<k>/, and the k-th top
+    seed (ranking 3, 1, 4, 2: seed 1 draw 2, seed 4 draw 3) reruns homing alone with draw k's policies, then the
+    analyses its claims read. Seed 2, fourth, reruns no homing. With homing_seeds=1 the DAG is the one before."""
+    from efish.config import compose
+
+    seeds = compose(["scale=laptop"]).scale.seed_numbers()
+    runs = {}
+    for name, config in (("three", []), ("one", ["overrides=scale.homing_seeds=1"])):
+        selected(tmp_path / name, seeds, [3, 1, 4, 2], "laptop")
+        result = dry_run(tmp_path / name, "--config", "scale=laptop", "run=laptop", *config, "--rerun-triggers",
+                         "mtime", "--printshellcmds")
+        assert result.returncode == 0, result.stderr[-2000:]
+        runs[name] = result.stdout
+    three, one = job_counts(runs["three"]), job_counts(runs["one"])
+    assert {rule: n - one.get(rule, 0) for rule, n in three.items() if n != one.get(rule, 0)} == DRAW_JOBS
+    assert one["train_policy"] == 2 and "top_seed_recipe_assay_with_hidden" not in one
+    assert "_draw_" not in runs["one"] and not re.search(r"seeds/seed_\d+/assays/homing", runs["one"])
+    out = runs["three"]
+    for k in (2, 3):
+        for recipe in ("homing", "homing_raycast"):
+            assert (f"efish train scale=laptop train.seed={k} policy={recipe} train.threads=1 --out "
+                    f"results/laptop/train/{recipe}_draw_{k} ") in out
+    assert "efish train scale=laptop policy=homing train.threads=1 --out results/laptop/train/homing " in out
+    for seed, k in ((1, 2), (4, 3)):
+        assert (f"efish assay scale=laptop scale.max_episodes=6 assay=homing --policy "
+                f"homing=results/laptop/train/homing_draw_{k}/final.pt "
+                f"homing_raycast=results/laptop/train/homing_raycast_draw_{k}/final.pt "
+                f"--out results/laptop/seeds/seed_{seed}/assays/homing ") in out
+        for analysis in ("homing", "dynamics"):
+            assert (f"efish analyze {analysis} scale=laptop assay=homing --tables "
+                    f"results/laptop/seeds/seed_{seed}/assays/homing --out "
+                    f"results/laptop/seeds/seed_{seed}/analysis/{analysis}/homing ") in out
+    assert "seeds/seed_2/assays/homing" not in out and "seeds/seed_3/assays/homing" not in out
+    assert "seeds/groups/homing" not in out  # never a group: two policies per seed
+    # the 2nd top seed's claims read its homing tables; the 4th's do not
+    claims = {m.group(1): m.group(0) for m in re.finditer(r"^rule top_seed_claims:\n    input: .*seed_(\d)/.*$", out,
+                                                          flags=re.M)}
+    assert "seeds/seed_1/analysis/homing/homing/trajectory_shape.parquet" in claims["1"]
+    assert "analysis/homing/homing" not in claims["2"]
+
+
+@pytest.mark.slow
+def test_the_second_top_seed_decides_the_homing_claims_with_its_own_draw_of_the_recipes(tmp_path):
+    """The smoke scale with scale.top_seeds=2 scale.homing_seeds=2, run for real up to the second top seed's claims
+    (2 min 40 s on one core): both homing recipes train again with train.seed 2, the second top seed reruns homing
+    with them, and its claims table carries the homing claims' parts, read from its own tables (C18's effect is
+    finite; C1-C3 need successful homing episodes, which nothing trained at this scale has)."""
+    from efish.layout import CLAIM_PARTS, RANKING, assay_table, recipe_draw, training_file
+
+    work = scratch_workflow(tmp_path / "work")
+    command = ["snakemake", "--cores", "1", "--config", "scale=smoke", "run=smoke",
+               "overrides=scale.top_seeds=2 scale.homing_seeds=2", "--directory", str(work),
+               "--snakefile", str(work / "Snakefile")]
+    run = Run("smoke", results_root=work / "results")
+
+    def make(target: Path) -> None:
+        result = subprocess.run([*command, str(target)], capture_output=True, text=True, timeout=900,
+                                env=smoke_env(work))
+        assert result.returncode == 0, result.stderr[-3000:]
+
+    make(Run("smoke").path(RANKING))  # the checkpoint first: which seed is second is known only then
+    second = int(pd.read_parquet(run.path(RANKING))["seed"].iloc[1])
+    make(Run("smoke").top_seed(second).path(CLAIM_PARTS))
+    for recipe in ("homing", "homing_raycast"):
+        config = run.path(training_file(recipe_draw(recipe, 2), "config.yaml")).read_text()
+        assert re.search(r"^  seed: 2$", config, flags=re.M), recipe
+    homing = run.top_seed(second).path(assay_table("homing", "episodes")).parent
+    recorded = json.loads((homing / "provenance.json").read_text())["command"]
+    assert "homing=results/smoke/train/homing_draw_2/final.pt" in recorded
+    assert "homing_raycast=results/smoke/train/homing_raycast_draw_2/final.pt" in recorded
+    parts = pd.read_parquet(run.top_seed(second).path(CLAIM_PARTS))
+    homing_parts = parts[parts["claim"].isin(["C1", "C2", "C3", "C18"])]
+    assert set(homing_parts["claim"]) == {"C1", "C2", "C3", "C18"}
+    assert not homing_parts["reason"].str.startswith("needs ").any(), homing_parts["reason"].tolist()
+    assert homing_parts.loc[homing_parts["claim"] == "C18", "effect"].map(np.isfinite).all()
 
 
 @pytest.mark.slow

@@ -65,6 +65,8 @@ def test_the_run_is_the_scale_or_the_scale_and_a_hash_of_its_overrides_or_its_na
     ({"scale": "huge"}, "efish config: unknown scale 'huge'"),
     ({"scale": "smoke", "overrides": "physics.tolerance=-1"}, "efish config: physics.tolerance=-1.0 is out of range"),
     ({"scale": "smoke", "overrides": "scale.assays=[nope]"}, "efish config: unknown assay 'nope'"),
+    ({"scale": "smoke", "overrides": "scale.homing_seeds=0"},
+     "efish config: scale.homing_seeds=0 is out of range: allowed [1, inf]"),
 ])
 def test_bad_input_is_one_line(config, message, tmp_path):
     with pytest.raises(PlanError) as caught:
@@ -189,6 +191,64 @@ def test_an_assay_the_top_seeds_cannot_rerun_as_a_group_is_one_line(plans):
         sampled.check_groups()
     dataclasses.replace(homing, cfg=dataclasses.replace(homing.cfg, scale=dataclasses.replace(
         homing.cfg.scale, top_seeds=0))).check_groups()  # no top seeds, no reruns
+
+
+# ------------------------------------------------------------------ the homing recipes' draws
+def test_the_homing_claims_are_decided_over_draws_of_the_homing_recipes(plans):
+    """scale.homing_seeds (smoke 1, laptop 3, study 4): draw 1 is the run's own homing recipes, draw k >= 2 trains
+    both again into a folder of its own, and the k-th top seed (ranking order) reruns homing with draw k, solo."""
+    laptop = plans["laptop"]
+    assert laptop.cfg.scale.homing_seeds == 3 and plans["study"].cfg.scale.homing_seeds == 4
+    assert laptop.recipe_claim_assays == ["homing"] and laptop.drawn_recipes == ["homing", "homing_raycast"]
+    assert laptop.draws == (2, 3) and plans["study"].draws == (2, 3, 4) and laptop.drawn_assays == ["homing"]
+    assert laptop.draw_trainings == ["homing_draw_2", "homing_raycast_draw_2", "homing_draw_3",
+                                     "homing_raycast_draw_3"]
+    # ranking 3, 1, 4, 2: seed 3 is the selected one (draw 1, the run's own); seed 2, fourth, reruns no homing
+    assert laptop.draw_seeds([3, 1, 4, 2]) == {1: 2, 4: 3} and laptop.draw_seeds([3]) == {}
+    assert "homing" not in laptop.top_seed_assays  # never in a group: it acts with two policies per seed
+    drawn = laptop.top_seed_claim_tables(True)
+    assert set(drawn) - set(laptop.seed_claim_tables) == {t for t in laptop.claim_tables
+                                                          if t.startswith(("assays/homing/", "analysis/"))
+                                                          and "/homing/" in t}
+    assert {"analysis/homing/homing/trajectory_shape.parquet", "analysis/dynamics/homing/decoding_episodes.parquet",
+            "analysis/homing/homing/alignment_episodes.parquet"} <= set(drawn)
+    assert laptop.top_seed_claim_tables(False) == laptop.seed_claim_tables
+    assert laptop.top_seed_analysis_assays(ANALYSES["homing"]) == ["homing"]
+    assert "homing" in laptop.top_seed_analysis_assays(ANALYSES["dynamics"])
+    assert "homing" not in laptop.seed_analysis_assays(ANALYSES["dynamics"])  # a training stage's: no draws
+    smoke = plans["smoke"]  # one draw: today's DAG
+    assert smoke.draws == () and smoke.draw_trainings == [] and smoke.drawn_assays == []
+    assert smoke.draw_seeds([2, 1]) == {} and smoke.top_seed_claim_tables(False) == smoke.seed_claim_tables
+    assert smoke.top_seed_analysis_assays(ANALYSES["homing"]) == []
+
+
+def test_draw_k_of_a_homing_recipe_trains_with_seed_offset_plus_k(plans):
+    laptop = plans["laptop"]
+    assert laptop.recipe_training("homing") == ("homing", "scale=laptop")  # the recipe's own seed, as before
+    assert laptop.recipe_training("homing_draw_2") == ("homing", "scale=laptop train.seed=2")
+    assert laptop.recipe_training("homing_raycast_draw_3") == ("homing_raycast", "scale=laptop train.seed=3")
+    offset = dataclasses.replace(laptop, cfg=dataclasses.replace(laptop.cfg, scale=dataclasses.replace(
+        laptop.cfg.scale, seed_offset=4)))
+    assert offset.draw_args(1) == offset.policy_args and offset.policy_args.endswith(" train.seed=5")
+    assert offset.draw_args(3).endswith(" train.seed=7")
+
+
+@pytest.mark.parametrize("overrides, message", [
+    ("scale.homing_seeds=2", "scale.homing_seeds=2 exceeds scale.top_seeds=1: the k-th top seed reruns homing with "
+                             "the k-th draw of its recipes, so set scale.homing_seeds at most 1"),
+    ("scale.top_seeds=0 scale.homing_seeds=2", "scale.homing_seeds=2 exceeds scale.top_seeds=0: "),
+])
+def test_more_draws_of_the_homing_recipes_than_top_seeds_is_one_line(overrides, message):
+    """Checked once the assays' policies are known (the workflow keeps those: they are not what failed)."""
+    with pytest.raises(PlanError) as caught:
+        RunPlan.from_config({"scale": "smoke", "overrides": overrides}, cache=None)
+    assert str(caught.value).startswith(message) and "\n" not in str(caught.value)
+
+
+def test_a_scale_without_the_homing_assay_ignores_homing_seeds():
+    plan = RunPlan.from_config({"scale": "smoke", "overrides": "scale.assays=[patchy4] scale.top_seeds=0 "
+                                "scale.homing_seeds=5"}, cache=None)
+    assert plan.drawn_recipes == [] and plan.draws == () and plan.draw_trainings == []
 
 
 def test_the_top_seeds_are_read_from_the_ranking_in_its_order(tmp_path):
@@ -317,3 +377,6 @@ def test_the_training_targets_are_every_seeds_and_every_recipe_an_assay_acts_wit
         "results/smoke/train/homing/final.pt", "results/smoke/train/homing_raycast/final.pt"]
     assert narrow.training_targets(Run("mine")) == ["results/mine/train/seed_1/final.pt",
                                                      "results/mine/train/seed_2/final.pt"]
+    # the later draws of the homing recipes too: they train beside the seeds, before the seed selection
+    assert plans["laptop"].training_targets(Run("laptop"))[-4:] == [
+        f"results/laptop/train/{name}/final.pt" for name in plans["laptop"].draw_trainings]

@@ -4,13 +4,14 @@
 # panels read; Analysis.written). The DAG asks for the analyses of each assay of the scale whose
 # input tables that assay writes (efish.run_plan: RunPlan.assay_analyses). The same rule per analysis, named
 # top_seed_analysis_<analysis>, runs on a top seed's rerun assays in its copy of the layout (the analyses the
-# claims read there; RunPlan.seed_analysis_assays), and stage_analysis_<analysis> on a training stage's
-# (learning.smk).
+# claims read there, homing's where the seed reruns it with a draw of the homing recipes;
+# RunPlan.top_seed_analysis_assays), and stage_analysis_<analysis> on a training stage's (RunPlan.seed_analysis_assays;
+# learning.smk).
 
 
 for analysis in ANALYSES.values():
     variants = [(None, "", analysis.assays),
-                (TOP_SEED, "top_seed_", across(lambda plan: plan.seed_analysis_assays(analysis))),
+                (TOP_SEED, "top_seed_", across(lambda plan: plan.top_seed_analysis_assays(analysis))),
                 (STAGE, "stage_", across(lambda plan: plan.seed_analysis_assays(analysis) if plan.stages.rerun else []))]
     for copy, prefix, assays in (v for v in variants if v[2]):
 

@@ -93,6 +93,37 @@ use rule top_seed_assay as top_seed_assay_with_hidden with:
         assay=any_of(across(lambda plan: plan.by_hidden(plan.top_seed_assays, hidden=True))),
 
 
+# The homing claims over several draws of the homing recipes (scale.homing_seeds): the homing assay acts with the
+# recipes alone, so a top seed's rerun with the run's own recipes would give the selected seed's tables again.
+# Instead the k-th top seed (k = 2..scale.homing_seeds, ranking order) reruns it with the k-th draw of the recipes
+# (train/<recipe>_draw_<k>/, train.smk; RunPlan.draw_seeds), in its copy of the layout, so each such copy is one
+# draw of the whole recipe (its foraging seed and its homing policies) and its claims carry homing verdicts for the
+# recipe's verdict over the top seeds. A group job gives every member one policy of its own and homing acts with
+# two (--policy homing=... homing_raycast=...), so each seed's rerun is a job of its own, as the run's assay job is.
+use rule assay as top_seed_recipe_assay with:
+    input:
+        unpack(draw_policies_input),
+    output:
+        **assay_outputs(hidden=False, copy=TOP_SEED),
+    log:
+        log("assays/{assay}", TOP_SEED),
+    benchmark:
+        benchmark("assays/{assay}", TOP_SEED)
+    params:
+        overrides=TOP_SEED_ARGS,
+        out=folder_of("steps"),
+        policies=policy_args,
+    wildcard_constraints:
+        assay=any_of(across(lambda plan: plan.by_hidden(plan.drawn_assays, hidden=False))),
+
+
+use rule top_seed_recipe_assay as top_seed_recipe_assay_with_hidden with:
+    output:
+        **assay_outputs(hidden=True, copy=TOP_SEED),
+    wildcard_constraints:
+        assay=any_of(across(lambda plan: plan.by_hidden(plan.drawn_assays, hidden=True))),
+
+
 # The supplement's top-seed panels: the top seeds' episodes in scale.top_seed_assays, stacked with seed and rank.
 rule top_seeds:
     input:

@@ -28,6 +28,7 @@ from efish.layout import (
     stage_copy,
     stage_name,
     stage_file,
+    recipe_draw,
     top_seed_copy,
     top_seed_group,
     training_file,
@@ -80,7 +81,6 @@ def any_of(names):
 ARGS = of_plan(lambda plan: plan.args)
 STAGE_ARGS = of_plan(lambda plan: plan.stage_args)
 TOP_SEED_ARGS = of_plan(lambda plan: plan.top_seed_args)
-POLICY_ARGS = of_plan(lambda plan: plan.policy_args)
 # What every plan keeps of its training (the train rule's outputs): the same in every point (efish.sweep).
 KEPT_STAGES = next(iter(PLANS.values())).stages.kept
 
@@ -226,6 +226,25 @@ def group_args(wildcards, input):
                      *(f"{seed}={input[name]}" for name, seed in seeds.items())])
 
 
+def seed_draw(wildcards):
+    """The draw of the homing recipes top seed {seed} reruns assay {assay} with: k for the k-th top seed, k =
+    2..scale.homing_seeds (efish.run_plan.RunPlan.draw_seeds). Another seed (a table asked for by hand) is an error
+    naming those that do."""
+    draws = plan_of(wildcards).draw_seeds(top_seeds(wildcards))
+    if int(wildcards.seed) not in draws:
+        raise ValueError(f"seed {wildcards.seed} does not rerun assay {wildcards.assay}; the top seeds that do: "
+                         f"{', '.join(map(str, draws)) or 'none'} (scale.homing_seeds)")
+    return draws[int(wildcards.seed)]
+
+
+def draw_policies_input(wildcards):
+    """The policies of top seed {seed}'s solo rerun of assay {assay} (acted by recipes alone: homing), by recipe
+    name: the final checkpoint of the seed's own draw of each recipe (efish.layout.recipe_draw)."""
+    k = seed_draw(wildcards)
+    recipes = plan_of(wildcards).policies_of(wildcards.assay)
+    return {name: recipe_policy(wildcards, recipe_draw(name, k)) for name in recipes}
+
+
 def group_of_seed(wildcards):
     """The group folder of assay {assay} that holds seed {seed}'s tables. A seed that does not rerun the assay (a
     table asked for by hand) is an error naming those that do, not a group job that leaves it out."""
@@ -261,10 +280,16 @@ def top_seed_tables(wildcards):
 def claims_inputs(wildcards):
     """The claims' tables among those the assays of this scale write (rollout tables and their analyses); for a top
     seed's claims (wildcard {seed}) or a training stage's ({stage}) those its rerun assays write in its copy of the
-    layout."""
+    layout (a top seed's homing too where it reruns homing with a draw of its recipes of its own)."""
     copy = copy_of(wildcards)
     plan = plan_of(wildcards)
-    paths = plan.claim_tables if copy is None else plan.seed_claim_tables
+    if copy is None:
+        paths = plan.claim_tables
+    elif getattr(wildcards, "seed", None) is not None:
+        drawn = bool(plan.draws) and int(wildcards.seed) in plan.draw_seeds(top_seeds(wildcards))
+        paths = plan.top_seed_claim_tables(drawn)
+    else:
+        paths = plan.seed_claim_tables
     return [results(path, copy, Run(wildcards.run)) for path in paths]
 
 

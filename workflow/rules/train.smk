@@ -4,6 +4,9 @@
 # checkpoints beside the declared output and writes final.pt atomically at the
 # end, so a killed job is rerun and resumes from its last checkpoint. A seed also keeps its policy at the
 # fractions scale.keep_stages of its training (stage_<k>.pt) for the claims along training (learning.smk).
+# The homing claims are decided over scale.homing_seeds draws of the homing recipes: draw 1 is train/<recipe>/,
+# draw k >= 2 the same recipe trained again with train.seed seed_offset + k into train/<recipe>_draw_<k>/
+# (efish.layout.recipe_draw; RunPlan.draw_trainings), which the k-th top seed reruns homing with (assays.smk).
 
 
 rule train:
@@ -33,11 +36,12 @@ rule train_policy:
     benchmark:
         benchmark("train/{policy}")
     params:
-        overrides=POLICY_ARGS,
+        overrides=lambda wildcards: plan_of(wildcards).recipe_training(wildcards.policy)[1],
+        recipe=lambda wildcards: plan_of(wildcards).recipe_training(wildcards.policy)[0],
         out=folder_of("final"),
     wildcard_constraints:
-        policy=any_of(across(lambda plan: plan.policy_recipes)),
+        policy=any_of(across(lambda plan: [*plan.policy_recipes, *plan.draw_trainings])),
     conda:
         "../envs/efish.yaml"
     shell:
-        efish("train", "policy={wildcards.policy} train.threads={threads} --out {params.out}")
+        efish("train", "policy={params.recipe} train.threads={threads} --out {params.out}")

@@ -422,6 +422,11 @@ class ScaleConfig:
                                    "decide the recipe's verdict better (docs/claims/index.md#the-recipes-verdict)",
                                    lo=1)
     top_seed_assays: list = param(["patchy4", "wide2", "square2"], "assays the top seeds run")
+    homing_seeds: int = param(3, "independent training draws of the homing recipes (homing, homing_raycast) the "
+                              "homing claims (C1-C3, C18) are decided over, at most max(1, top_seeds): draw 1 is the "
+                              "run's own, draw k >= 2 trains both recipes again with train.seed seed_offset + k and "
+                              "the k-th top seed reruns homing with it (2 extra trainings of homing_steps per draw); "
+                              "ignored by a scale without the homing assay", lo=1)
     keep_stages: list = param([], "fractions of each seed's training at which it keeps its policy for the claims "
                               "along training (train.keep_stages reads it; [] = none)")
     learning: bool = param(False, "the claims along training (snakemake learning: the selected seed's assays, "
