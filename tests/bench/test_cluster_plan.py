@@ -177,3 +177,30 @@ def test_a_top_seed_group_scales_with_its_seeds_and_its_links_are_taken_as_measu
         work, memory = model.units(Job("top_seed_group", {"run": "laptop", "assay": assay}, None))
         assert work == memory == pytest.approx(model._assay_steps(assay) * seeds)
     assert model.units(Job("top_seed_assay", {"run": "laptop", "seed": "2", "assay": claim}, None)) is None
+
+
+def test_a_later_draw_of_a_homing_recipe_is_priced_as_its_recipes_training(tmp_path):
+    """scale.homing_seeds: train/homing_draw_2 is the homing recipe trained with another seed, and a top seed's solo
+    rerun of homing with its draw is the run's homing assay again; a draw never measured takes the measured
+    recipe trainings' estimate."""
+    from efish.bench.cluster import Job
+
+    model = CostModel(["scale=smoke"])
+    for recipe in ("homing", "homing_raycast"):
+        assert model.units(Job("train_policy", {"run": "x", "policy": f"{recipe}_draw_2"}, None)) == model.units(
+            Job("train_policy", {"run": "x", "policy": recipe}, None))
+    homing = model.units(Job("assay_with_hidden", {"run": "x", "assay": "homing"}, None))
+    assert homing and model.units(Job("top_seed_recipe_assay_with_hidden",
+                                      {"run": "x", "seed": "1", "assay": "homing"}, None)) == homing
+    dry = ("rule train_policy:\n    benchmark: results/big/benchmarks/train/homing.tsv\n"
+           "    wildcards: run=big, policy=homing\n"
+           "rule train_policy:\n    benchmark: results/big/benchmarks/train/homing_draw_2.tsv\n"
+           "    wildcards: run=big, policy=homing_draw_2\n")
+    path = tmp_path / "benchmarks/train/homing.tsv"
+    path.parent.mkdir(parents=True)
+    path.write_text(HEADER + "100\t0:00:00\t800\t1\t1\t1\t0\t0\t50\t90\n")
+    plan = plan_jobs(parse_dry_run(dry), read_benchmarks(tmp_path / "benchmarks"), model,
+                     CostModel(["scale=smoke", "scale.homing_steps=400"])).set_index("job")
+    assert plan.loc["policy=homing_draw_2", "measured"]
+    assert plan.loc["policy=homing_draw_2", "runtime_min"] == pytest.approx(plan.loc["policy=homing", "runtime_min"])
+    assert plan.loc["policy=homing", "work_ratio"] == pytest.approx(4.0)  # smoke's homing_steps: 100

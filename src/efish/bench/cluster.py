@@ -9,9 +9,12 @@ scaled by the cost model of its rule:
 - ``train``, ``train_policy``: env steps x agents x (3 epochs + 1) x model FLOPs
   per sample (``efish.bench.train.forward_flops``: width^2 terms and the input
   layers); memory by the rollout buffer (arenas x rollout steps x agents x
-  (observation + state + 2 widths) values);
+  (observation + state + 2 widths) values); a later draw of a homing recipe
+  (``train/homing_draw_2``, ``scale.homing_seeds``) is its recipe's training;
 - assays, seed evaluation and the analyses of an assay: agent-steps (episodes
-  x episode steps x agents, summed over the assay's conditions);
+  x episode steps x agents, summed over the assay's conditions); a top seed's
+  own rerun of homing with its draw of the recipes (``top_seed_recipe_assay*``)
+  is the run's homing assay again;
 - everything else (selection, panels, pages, benchmarks, ...): as measured.
 
 A job's cost is its CPU time (``cpu_time`` of the benchmark file; the wall time
@@ -39,7 +42,7 @@ import yaml
 from ..config import compose
 from ..config.schema import EfishConfig
 from ..env.observe import observation_size
-from ..layout import BENCHMARKS
+from ..layout import BENCHMARKS, parse_recipe_draw
 from .train import forward_flops
 
 HEADROOM = 1.5  # the profile's runtime and memory must cover this many times the estimate
@@ -142,15 +145,17 @@ class CostModel:
         rule, wc = job.rule, job.wildcards
         if rule == "train":
             return self._training()
-        if rule == "train_policy":
-            return self._training(f"policy={wc['policy']}")
+        if rule == "train_policy":  # a recipe, or a later draw of one: the same training with another seed
+            return self._training(f"policy={parse_recipe_draw(wc['policy'])[0]}")
         assay = "selection" if rule == "evaluate_seed" else wc.get("assay")
         if assay and rule == "top_seed_group":  # one job rolls out every top seed that reruns the assay
             steps = self._assay_steps(assay) * self._group_size(assay)
             return steps, steps
         # the top seeds' analyses are the same work as the selected seed's; their top_seed_assay jobs only link
-        # the group's tables (taken as measured)
-        if assay and (rule in ("evaluate_seed", "assay", "assay_with_hidden")
+        # the group's tables (taken as measured); a top seed's solo rerun of homing with its draw of the recipes is
+        # the run's homing assay again
+        if assay and (rule in ("evaluate_seed", "assay", "assay_with_hidden", "top_seed_recipe_assay",
+                               "top_seed_recipe_assay_with_hidden")
                       or rule.startswith(("analysis_", "top_seed_analysis_"))):
             steps = self._assay_steps(assay)
             return steps, steps
