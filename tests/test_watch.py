@@ -113,6 +113,9 @@ def test_plot_draws_every_metric_with_a_title_and_each_task_on_its_own_axes(resu
     assert not set(columns) & {"update", "env_steps", "wall_s", "total_updates"}
     assert task_groups(["seed_2", "homing", "seed_10", "homing_raycast"]) == {
         "foraging seeds": ["seed_2", "seed_10"], "homing": ["homing"], "homing_raycast": ["homing_raycast"]}
+    # a later draw of a homing recipe (scale.homing_seeds) is the same task: on its recipe's axes
+    assert task_groups(["homing", "homing_draw_2", "homing_raycast", "homing_raycast_draw_2"]) == {
+        "homing": ["homing", "homing_draw_2"], "homing_raycast": ["homing_raycast", "homing_raycast_draw_2"]}
 
 
 def test_the_live_table_refreshes_until_ctrl_c(results, capsys, monkeypatch):
@@ -141,3 +144,13 @@ def test_bad_input_is_one_line(tmp_path, capsys, make, args, message):
     assert main(["watch", "absent", "--results", str(tmp_path), *args]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and re.search(message, err), err
+
+
+def test_a_later_draw_of_a_homing_recipe_plans_its_recipes_updates():
+    """train/homing_draw_2 (scale.homing_seeds) is the homing recipe trained again with another seed."""
+    from efish.watch import _recipe_updates
+
+    homing = _recipe_updates("laptop", "homing")
+    assert homing and _recipe_updates("laptop", "homing_draw_2") == homing
+    assert _recipe_updates("laptop", "homing_raycast_draw_3") == _recipe_updates("laptop", "homing_raycast")
+    assert _recipe_updates("laptop", "nothing_draw_2") is None

@@ -28,7 +28,7 @@ import pandas as pd
 
 from .config import compose, config_dir
 from .io import atomic_path, read_parquet
-from .layout import FINAL_POLICY, TRAINING_METRICS, Run, seed_name, training_folder
+from .layout import FINAL_POLICY, TRAINING_METRICS, Run, parse_recipe_draw, seed_name, training_folder
 
 NOT_STARTED, RUNNING, FINISHED = "not started", "running", "finished"
 #: The table's return: the mean of this many last finite episode returns (updates where no episode ended have none).
@@ -84,10 +84,12 @@ def planned_updates(run_name: str) -> dict[str, int | None]:
 
 
 def _recipe_updates(run_name: str, name: str) -> int | None:
-    """The updates of a policy recipe's job under a shipped scale, else None."""
-    if not _is_shipped_scale(run_name) or not (config_dir() / "policy" / f"{name}.yaml").is_file():
+    """The updates of a policy recipe's job (or of a later draw of it, ``homing_draw_2``: the same training with
+    another seed) under a shipped scale, else None."""
+    recipe = parse_recipe_draw(name)[0]
+    if not _is_shipped_scale(run_name) or not (config_dir() / "policy" / f"{recipe}.yaml").is_file():
         return None
-    return compose([f"scale={run_name}", f"policy={name}"]).train.total_updates()
+    return compose([f"scale={run_name}", f"policy={recipe}"]).train.total_updates()
 
 
 def _is_shipped_scale(run_name: str) -> bool:
@@ -219,9 +221,12 @@ def curve_columns(metrics: dict[str, pd.DataFrame | None]) -> list[str]:
 
 def task_groups(names: list[str]) -> dict[str, list[str]]:
     """Jobs grouped by task, each group drawn on its own axes: the foraging seeds together, each policy recipe
-    (homing: another task, another reward scale) alone."""
+    (homing: another task, another reward scale) with its later draws (``homing_draw_2``, scale.homing_seeds)."""
     seeds = [n for n in names if is_seed(n)]
-    return {**({"foraging seeds": seeds} if seeds else {}), **{n: [n] for n in names if n not in seeds}}
+    recipes: dict[str, list[str]] = {}
+    for name in (n for n in names if n not in seeds):
+        recipes.setdefault(parse_recipe_draw(name)[0], []).append(name)
+    return {**({"foraging seeds": seeds} if seeds else {}), **recipes}
 
 
 def steps_label(value: float, _position=None) -> str:
