@@ -500,10 +500,15 @@ class AnalysisConfig:
     claims_alpha: float = param(0.05, "claims: a test is significant at p below this", lo=0.0, hi=1.0)
     claims_aligned_rad: float = param(math.pi / 4, "homing alignment_episodes (claim C2): |error| within this of 0 "
                                       "or pi counts as aligned, rad", lo=0.0, hi=math.pi / 2)
-    claims_margin_fraction: float = param(0.2, "claims: equivalence margin of a 'no difference' part (TOST), as a "
-                                          "fraction of the control's median", lo=0.0)
-    claims_margin_sd: float = param(0.5, "claims: equivalence margin in pooled SDs, used where the control's median "
-                                    "is within one pooled SD of 0", lo=0.0)
+    # The two margins below decided "no difference" parts before each part had its smallest effect of interest
+    # (efish.claims.deltas). Nothing reads them now; they stay because every recorded config (conditions.parquet,
+    # analysis_settings.parquet) of a run made before holds them, and a key the schema lacks cannot be read back.
+    claims_margin_fraction: float = param(0.2, "claims, no longer read (each part's delta decides): the earlier "
+                                          "equivalence margin, a fraction of the control's median; kept so that "
+                                          "tables recorded with it can be read", lo=0.0)
+    claims_margin_sd: float = param(0.5, "claims, no longer read (each part's delta decides): the earlier "
+                                    "equivalence margin in pooled SDs; kept so that tables recorded with it can be "
+                                    "read", lo=0.0)
     claims_ceiling_share: float = param(0.5, "claims: a condition that ate every pellet in at least this share of "
                                         "its episodes is at a ceiling: its food parts are not decidable", lo=0.0,
                                         hi=1.0)
