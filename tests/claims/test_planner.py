@@ -187,3 +187,18 @@ def test_where_the_run_kept_stages_each_part_shows_its_effect_along_training(tmp
     row = pd.read_parquet(out / "power.parquet").iloc[0]
     assert row["stage_effects"] == "60k: 0.05, 240k: 0.3" and row["trend"] == "moving toward the paper's sign"
     assert "| 60k: 0.05, 240k: 0.3 | moving toward the paper's sign |" in (out / "power.md").read_text()
+
+
+def test_more_episodes_help_where_the_spread_is_within_seeds_and_not_where_seeds_differ():
+    """Planted parts: one whose seeds agree but whose episodes scatter (tau 0, sigma large), one whose seeds differ
+    (tau large, sigma small). Four times the episodes cuts the first's seeds, not the second's."""
+    rng = np.random.default_rng(9)
+    tables = {s: pd.concat([parts_table(rng, {"within": 0.2}, tau=0.0, sigma=0.6, n=8, delta=0.1),
+                            parts_table(rng, {"between": 0.2}, tau=0.15, sigma=0.02, n=8, delta=0.1)])
+              for s in range(1, 9)}
+    plan = plan_parts(tables, ALPHA, COSTS).set_index("part")
+    within, between = plan.loc["within"], plan.loc["between"]
+    assert within["seeds_holds_at_2delta_more_episodes"] < 0.5 * within["seeds_holds_at_2delta"]
+    assert between["seeds_holds_at_2delta_more_episodes"] >= 0.9 * between["seeds_holds_at_2delta"]
+    k = int(between["seeds_holds_at_2delta_more_episodes"])
+    assert between["cpu_hours_holds_at_2delta_more_episodes"] == pytest.approx(k * (400 + 20 + 4 * 180) / 3600)

@@ -35,7 +35,7 @@ from .power import standard_error as interval_se
 from .recipe import FISHER_Z, fisher_z
 from .verdicts import interval_level
 
-__all__ = ["CURVE_COLUMNS", "PLAN_COLUMNS", "STAGE_PLAN_COLUMNS", "PartModel", "RunCosts", "claim_curves", "part_models", "plan_parts",
+__all__ = ["CURVE_COLUMNS", "MORE_EPISODES", "PLAN_COLUMNS", "STAGE_PLAN_COLUMNS", "PartModel", "RunCosts", "claim_curves", "part_models", "plan_parts",
            "plan_table", "power_curves", "read_run", "run_costs", "with_stages"]
 
 #: The column suffix of each of :data:`~efish.claims.power.SCENARIOS`, in its order.
@@ -49,7 +49,12 @@ CURVE_COLUMNS = ["claim", "part", "seeds", "cpu_hours", *SCENARIO_KEYS]
 #: scenario's verdict now and the seeds (and CPU-hours) that reach :data:`~efish.claims.power.TARGET`.
 PLAN_COLUMNS = ["claim", "part", "sign", "delta", "seeds", "units", "effect", "tau", "sigma",
                 "now_holds_at_2delta", "now_absent_at_0", "seeds_holds_at_2delta", "seeds_absent_at_0",
-                "cpu_hours_holds_at_2delta", "cpu_hours_absent_at_0", "note"]
+                "cpu_hours_holds_at_2delta", "cpu_hours_absent_at_0", "seeds_holds_at_2delta_more_episodes",
+                "cpu_hours_holds_at_2delta_more_episodes", "note"]
+#: The other design the plan prices: every seed reruns the claims' assays at this many times the run's episodes.
+#: Only the within-seed part of the spread (sigma^2 / n) shrinks with them; where the seeds differ (tau), it
+#: needs about as many seeds as before, at a higher price.
+MORE_EPISODES = 4
 #: Where the run kept training stages (the claims along training), the plan gains the selected seed's effect at each
 #: stage (``stage_effects``: "240k: 0.01, 480k: 0.05", env steps and effect) and the part's trend over them: an
 #: effect still growing says longer training, not more seeds, is the lever.
@@ -67,9 +72,11 @@ class RunCosts(NamedTuple):
     seeds_timed: str
     run_s: float = np.nan  # the whole run's CPU time (every job's benchmark file), for "x times this run"
 
-    def design_hours(self, seeds: int | None) -> float:
-        """CPU-hours of a design of ``seeds`` seeds at the run's episodes (NaN when no design reaches it)."""
-        return np.nan if seeds is None else seeds * (self.train_s + self.selection_s + self.rerun_s) / 3600
+    def design_hours(self, seeds: int | None, episodes: float = 1.0) -> float:
+        """CPU-hours of a design of ``seeds`` seeds, each rerunning the claims' assays at ``episodes`` times the run's
+        episodes (training and selection do not grow with them; NaN when no design reaches it)."""
+        per_seed = self.train_s + self.selection_s + episodes * self.rerun_s
+        return np.nan if seeds is None else seeds * per_seed / 3600
 
 
 def _cpu_seconds(path: Path) -> float:
@@ -186,6 +193,11 @@ def plan_part(model: PartModel, alpha: float, costs: RunCosts) -> dict:
         out[f"cpu_hours_{key}"] = costs.design_hours(k)
         if k is None:
             notes.append(f"{name}: not within {MAX_SEEDS} seeds")
+        if key == SCENARIO_KEYS[0]:  # the same question with more episodes per seed
+            more = seeds_needed(comp, model.sign, model.planned_delta, alpha, theta, verdict, model.family,
+                                units=MORE_EPISODES * comp.units)
+            out[f"seeds_{key}_more_episodes"] = np.nan if more is None else more
+            out[f"cpu_hours_{key}_more_episodes"] = costs.design_hours(more, MORE_EPISODES)
     return out | {"note": "; ".join(notes)}
 
 

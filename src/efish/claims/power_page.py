@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .planner import RunCosts, target_line
+from .planner import MORE_EPISODES, RunCosts, target_line
 from .power import MAX_SEEDS, TARGET
 
 
@@ -49,8 +49,8 @@ def power_markdown(plan: pd.DataFrame, costs: RunCosts, header: str, alpha: floa
              f"{TARGET:.0%}.", "",
              f"{int(planned.sum())} of {len(plan)} parts planned.", "",
              "| claim | part | delta | seeds | effect | tau | sigma | holds at 2 delta: now | seeds (CPU-h) "
-             "| absent at 0: now | seeds (CPU-h) | note |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             f"| the same at {MORE_EPISODES}x episodes | absent at 0: now | seeds (CPU-h) | note |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     stages = "trend" in plan.columns
     if stages:
         lines[-2] = lines[-2].rstrip(" |") + " | along training (env steps: effect) | trend |"
@@ -58,7 +58,9 @@ def power_markdown(plan: pd.DataFrame, costs: RunCosts, header: str, alpha: floa
     for row in plan.itertuples(index=False):
         cells = [row.claim, row.part, _number(row.delta), str(int(row.seeds)), _number(row.effect),
                  _number(row.tau), _number(row.sigma), _chance(row.now_holds_at_2delta),
-                 _seeds(row.seeds_holds_at_2delta, row.cpu_hours_holds_at_2delta), _chance(row.now_absent_at_0),
+                 _seeds(row.seeds_holds_at_2delta, row.cpu_hours_holds_at_2delta),
+                 _seeds(row.seeds_holds_at_2delta_more_episodes, row.cpu_hours_holds_at_2delta_more_episodes),
+                 _chance(row.now_absent_at_0),
                  _seeds(row.seeds_absent_at_0, row.cpu_hours_absent_at_0), row.note,
                  *([row.stage_effects, row.trend] if stages else [])]
         lines.append("| " + " | ".join(str(c).replace("|", "/") for c in cells) + " |")
