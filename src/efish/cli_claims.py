@@ -107,6 +107,7 @@ def run_power(args, cfg, started) -> None:
                        f"What a decisive verdict costs: run {run.name}, seeds {seeds}")
     write_metadata(out, cfg, started, args, name="power.provenance.json", results=str(run.results),
                    seeds=list(tables), costs=costs._asdict())
+    write_metadata(figures, cfg, started, args, name="power.provenance.json", table=str(written[0]))
     print("\n".join(summary["line"]))
     print(headline(plan, costs))
     print(f"wrote {', '.join(map(str, [*written, page, *drawn]))}")

@@ -144,6 +144,7 @@ def test_power_command_writes_its_tables_page_and_figure(tmp_path, capsys):
     page = (out / "power.md").read_text()
     assert "| C9 | p |" in page and "1 of 1 parts planned" in page and "0.117 CPU-hours" in page  # 420 s a seed
     assert (figures / "power.png").stat().st_size > 0 and (figures / "power.pdf").exists()
+    assert (figures / "config.yaml").is_file() and (figures / "power.provenance.json").is_file()
     summary = pd.read_parquet(out / "power_claims.parquet").iloc[0]
     k = int(plan["seeds_holds_at_2delta"].iloc[0])
     assert summary["seeds_holds_at_2delta"] == k and summary["undecided"] == 1 and summary["unplanned"] == 0

@@ -293,27 +293,28 @@ def test_the_top_seeds_rerun_homing_each_with_its_own_draw_of_the_homing_recipes
 
 
 @pytest.mark.slow
-def test_the_second_top_seed_decides_the_homing_claims_with_its_own_draw_of_the_recipes(tmp_path):
-    """The smoke scale with scale.top_seeds=2 scale.homing_seeds=2, run for real up to the second top seed's claims
-    (2 min 40 s on one core): both homing recipes train again with train.seed 2, the second top seed reruns homing
-    with them, and its claims table carries the homing claims' parts, read from its own tables (C18's effect is
-    finite; C1-C3 need successful homing episodes, which nothing trained at this scale has)."""
+def test_the_second_top_seed_decides_the_homing_claims_with_its_own_draw_of_the_recipes(smoke_run, tmp_path):
+    """The smoke run's seeds and selection, with scale.top_seeds=2 scale.homing_seeds=2: both homing recipes train
+    again with train.seed 2, the second top seed reruns homing with them and runs the analyses the homing claims
+    read, and its claims carry the homing claims' parts from its own tables (C18's effect is finite; C1-C3 need
+    successful homing episodes, which nothing trained at this scale has). Only the homing tables are made: the
+    other claims' reruns are the grouped reruns' test."""
     from efish.layout import CLAIM_PARTS, RANKING, assay_table, recipe_draw, training_file
+    from efish.run_plan import RunPlan
 
     work = scratch_workflow(tmp_path / "work")
-    command = ["snakemake", "--cores", "1", "--config", "scale=smoke", "run=smoke",
-               "overrides=scale.top_seeds=2 scale.homing_seeds=2", "--directory", str(work),
-               "--snakefile", str(work / "Snakefile")]
+    for part in ("train", "selection", "analysis/selection"):  # the checkpoint done, in time order (copy2: mtimes)
+        shutil.copytree(smoke_run / "results/smoke" / part, work / "results/smoke" / part)
+    overrides = "scale.top_seeds=2 scale.homing_seeds=2"
     run = Run("smoke", results_root=work / "results")
-
-    def make(target: Path) -> None:
-        result = subprocess.run([*command, str(target)], capture_output=True, text=True, timeout=900,
-                                env=smoke_env(work))
-        assert result.returncode == 0, result.stderr[-3000:]
-
-    make(Run("smoke").path(RANKING))  # the checkpoint first: which seed is second is known only then
     second = int(pd.read_parquet(run.path(RANKING))["seed"].iloc[1])
-    make(Run("smoke").top_seed(second).path(CLAIM_PARTS))
+    copy = Run("smoke").top_seed(second)  # its tables as Snakemake names them, relative to the work folder
+    tables = RunPlan.from_config({"scale": "smoke", "overrides": overrides}).claims_read(["homing"])
+    result = subprocess.run(["snakemake", "--cores", "1", "--config", "scale=smoke", "run=smoke",
+                             f"overrides={overrides}", "--rerun-triggers", "mtime", "--directory", str(work),
+                             "--snakefile", str(work / "Snakefile"), *[str(copy.path(t)) for t in tables]],
+                            capture_output=True, text=True, timeout=900, env=smoke_env(work))
+    assert result.returncode == 0, result.stderr[-3000:]
     for recipe in ("homing", "homing_raycast"):
         config = run.path(training_file(recipe_draw(recipe, 2), "config.yaml")).read_text()
         assert re.search(r"^  seed: 2$", config, flags=re.M), recipe
@@ -321,7 +322,12 @@ def test_the_second_top_seed_decides_the_homing_claims_with_its_own_draw_of_the_
     recorded = json.loads((homing / "provenance.json").read_text())["command"]
     assert "homing=results/smoke/train/homing_draw_2/final.pt" in recorded
     assert "homing_raycast=results/smoke/train/homing_raycast_draw_2/final.pt" in recorded
-    parts = pd.read_parquet(run.top_seed(second).path(CLAIM_PARTS))
+    out = tmp_path / "claims"
+    claims = subprocess.run(["efish", "claims", "scale=smoke", "scale.top_seeds=2", "scale.homing_seeds=2",
+                             "--results", str(run.top_seed(second).results), "--out", str(out)],
+                            capture_output=True, text=True, timeout=300, env=smoke_env(work))
+    assert claims.returncode == 0, claims.stderr[-2000:]
+    parts = pd.read_parquet(out / Path(CLAIM_PARTS).name)
     homing_parts = parts[parts["claim"].isin(["C1", "C2", "C3", "C18"])]
     assert set(homing_parts["claim"]) == {"C1", "C2", "C3", "C18"}
     assert not homing_parts["reason"].str.startswith("needs ").any(), homing_parts["reason"].tolist()
