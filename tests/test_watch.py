@@ -38,6 +38,14 @@ def watch_lines(capsys, *args: str) -> list[str]:
     return capsys.readouterr().out.splitlines()
 
 
+def test_a_run_is_named_by_its_folder_as_well_as_by_its_name(results, capsys):
+    by_name = watch_lines(capsys, RUN, "--results", str(results), "--once")
+    by_folder = watch_lines(capsys, str(results / RUN), "--once")
+    # the same jobs, states and updates (the title's time and each job's age move between the two calls)
+    assert [line.split()[:3] for line in by_folder[1:]] == [line.split()[:3] for line in by_name[1:]]
+    assert len(by_folder) == len(by_name) > 2
+
+
 def test_once_shows_a_finished_and_a_running_seed_with_their_updates(results, capsys):
     title, header, first, second = watch_lines(capsys, RUN, "--results", str(results), "--once")
     assert title.startswith(f"{RUN}: 1/2 training jobs finished")

@@ -189,7 +189,8 @@ def _training_commands(sub: argparse._SubParsersAction) -> None:
                      "Show every training job of a run in a table refreshed in place: update, return, entropy, KL, "
                      "speed, ETA and state, from their metrics.parquet. Writes nothing but the --plot PNG.",
                      "docs/tutorials/watch-a-run.md", "docs/methods/training.md#live-logs")
-    wa.add_argument("run", help="the run's folder name under --results (smoke, laptop-453280a3)")
+    wa.add_argument("run", help="the run's folder name under --results (smoke, laptop-453280a3), or its folder "
+                                "(results/laptop)")
     wa.add_argument("--results", type=Path, default=Path("results"), help="the results root (default results)")
     wa.add_argument("--interval", type=float, default=10.0, help="seconds between refreshes (default 10)")
     wa.add_argument("--once", action="store_true", help="print the table once and exit")
@@ -613,7 +614,10 @@ def _watch(args, cfg, started) -> None:
     from .watch import watch
 
     try:
-        watch(Run(args.run, results_root=args.results), args.interval, args.once, args.plot)
+        where = Path(args.run)  # a run's name under --results, or its folder as the README's table spells it
+        run = Run(where.name, results_root=where.parent) if len(where.parts) > 1 else Run(args.run,
+                                                                                           results_root=args.results)
+        watch(run, args.interval, args.once, args.plot)
     except KeyboardInterrupt:  # Ctrl-C is how a live table is left: not an error
         pass
 
