@@ -39,3 +39,18 @@ def test_the_readme_quotes_every_measured_time_with_how_it_was_measured_on_recor
 def test_a_stale_quote_is_caught():
     assert QUOTE.findall("the laptop run, about 45 minutes on 2 cores; smoke ~4 min") == ["45 minutes", "4 min"]
     assert normal("45 minutes") not in {entry["quote"] for entry in measured().values()}
+
+
+TEST_COUNT = re.compile(r"(\d{1,3}(?:,\d{3})+|\d+) tests\b")
+
+
+def test_the_ci_time_and_its_test_count_on_the_architecture_page_are_the_measured_ones():
+    """The architecture page's CI paragraph quotes the same run as measured-times.yml: its minutes and its count of
+    tests (the last number before "tests" in each)."""
+    entry = measured()["tests"]["measured"]
+    page = (DOCS / "architecture.md").read_text()
+    paragraph = page[page.index("`.ci/run` on a clean clone of commit"):]
+    paragraph = paragraph.split("\n\n")[0]  # to the paragraph's end (or the page's)
+    assert TEST_COUNT.findall(paragraph)[-1] in TEST_COUNT.findall(entry), (paragraph[:200], entry)
+    minutes = re.search(r"took (\d+(?:\.\d+)?) min", paragraph).group(1)
+    assert f"{minutes} min" in entry, (minutes, entry)
