@@ -232,12 +232,7 @@ def _compare_runs_command(sub: argparse._SubParsersAction) -> None:
     cr.add_argument("runs", nargs="*", metavar="RUN",
                     help="a run name under --results (smoke, laptop-453280a3) or a run's folder (one holding train/); "
                          "one or more in all, with --sweep's")
-    cr.add_argument("--sweep", help="also every run of this sweep, in grid order: the grid given to the workflow's "
-                                    "--config sweep= (inline or a YAML file), with --scale and --overrides")
-    cr.add_argument("--scale", help="the sweep's scale (--config scale=; default: the workflow's)")
-    cr.add_argument("--overrides", default="", help="the sweep's run overrides (--config overrides=)")
-    cr.add_argument("--results", type=Path, default=RESULTS_ROOT,
-                    help="where a run name's folder is (default results/)")
+    _add_sweep(cr)
     _add_out(cr, "write the table (run, metric, seeds, final_mean, ci_low, ci_high, env_steps) as .parquet or .csv; "
                  "a folder gets compare_runs.parquet")
     cr.add_argument("--plot", type=Path, metavar="F.png", help="draw the curves to this PNG, and the same as .pdf "
@@ -408,6 +403,17 @@ def _claims_by_stage_command(sub: argparse._SubParsersAction) -> None:
     cbs.set_defaults(handler=run_claims_by_stage)
 
 
+def _add_sweep(parser: argparse.ArgumentParser) -> None:
+    """What a command over several runs takes beside their names: a sweep's runs (``--sweep`` with ``--scale`` and
+    ``--overrides``, as the workflow's ``--config`` names them) and the results root the names are under."""
+    parser.add_argument("--sweep", help="also every run of this sweep, in grid order: the grid given to the "
+                                        "workflow's --config sweep= (inline or a YAML file), with --scale and --overrides")
+    parser.add_argument("--scale", help="the sweep's scale (--config scale=; default: the workflow's)")
+    parser.add_argument("--overrides", default="", help="the sweep's run overrides (--config overrides=)")
+    parser.add_argument("--results", type=Path, default=RESULTS_ROOT, help="where a run name's folder is (default "
+                                                                           "results/)")
+
+
 def _compare_claims_command(sub: argparse._SubParsersAction) -> None:
     """``efish compare-claims``: runs' verdicts side by side."""
     cc = add_command(sub, "compare-claims", "two or more runs' claim verdicts and effect sizes side by side",
@@ -417,12 +423,7 @@ def _compare_claims_command(sub: argparse._SubParsersAction) -> None:
     cc.add_argument("runs", nargs="*", metavar="RUN",
                     help="claims.parquet, a claims folder, or a run name (results/<name>/claims/claims.parquet); two "
                          "or more in all, with --sweep's")
-    cc.add_argument("--sweep", help="also every run of this sweep, in grid order: the grid given to the workflow's "
-                                    "--config sweep= (inline or a YAML file), with --scale and --overrides")
-    cc.add_argument("--scale", help="the sweep's scale (--config scale=; default: the workflow's)")
-    cc.add_argument("--overrides", default="", help="the sweep's run overrides (--config overrides=)")
-    cc.add_argument("--results", type=Path, default=RESULTS_ROOT,
-                    help="where a run name's folder is (default results/)")
+    _add_sweep(cc)
     _add_out(cc, "write the claims x runs table (each run's recipe verdict and effect where it has them, its verdict "
                  "and effect) as .parquet or .csv")
     cc.add_argument("--heatmap", type=Path, help="draw the claims x runs heatmap as a PNG (cell colour: each run's "

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .io import atomic_path
+from .io import TABLE_SUFFIXES, write_table_file
 from .layout import RESULTS_ROOT, Run, training_folder
 from .watch import (
     CURVE_LABELS,
@@ -41,7 +41,6 @@ from .watch import (
 RETURN = "episode_return"  # the first panel and the table's first rows
 LEVEL = 0.95  # the interval over seeds
 TABLE_NAME = "compare_runs"  # --out given as a folder: compare_runs.parquet in it
-TABLE_SUFFIXES = (".parquet", ".csv")
 COLUMNS = ("run", "metric", "seeds", "final_mean", "ci_low", "ci_high", "env_steps")
 
 
@@ -201,14 +200,7 @@ def check_outputs(out: Path | None, plot: Path | None) -> None:
 
 def write_table(table: pd.DataFrame, out: Path) -> Path:
     """The table as Parquet or CSV by ``out``'s suffix, or ``out/compare_runs.parquet`` for a folder; atomically."""
-    path = out if out.suffix else out / f"{TABLE_NAME}.parquet"
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(path) as tmp:
-        if path.suffix == ".csv":
-            table.to_csv(tmp, index=False)
-        else:
-            table.to_parquet(tmp, index=False)
-    return path
+    return write_table_file(table, out if out.suffix else out / f"{TABLE_NAME}.parquet")
 
 
 def plot_runs(runs: Sequence[RunMetrics], metrics: Sequence[str], path: Path, title: str) -> list[Path]:

@@ -149,3 +149,22 @@ def write_run_metadata(folder: str | os.PathLike, config_yaml: str, started: dat
     folder = Path(folder)
     write_text_atomic(folder / "config.yaml", config_yaml)
     write_text_atomic(folder / name, json.dumps(provenance(started, extra), indent=2) + "\n")
+
+
+#: What :func:`write_table_file` writes, by the file's suffix.
+TABLE_SUFFIXES = (".parquet", ".csv")
+
+
+def write_table_file(table, path: str | os.PathLike) -> Path:
+    """A pandas table as Parquet or CSV by ``path``'s suffix (no index), written atomically; another suffix is one
+    ValueError naming the two."""
+    path = Path(path)
+    if path.suffix not in TABLE_SUFFIXES:
+        raise ValueError(f"--out {path}: the table is written as {' or '.join(TABLE_SUFFIXES)}")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_path(path) as tmp:
+        if path.suffix == ".parquet":
+            table.to_parquet(tmp, index=False)
+        else:
+            table.to_csv(tmp, index=False)
+    return path

@@ -15,11 +15,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..io import atomic_path
+from ..io import TABLE_SUFFIXES, write_table_file
 from .report import has_recipe
 
-#: What ``--out`` writes, by the file's suffix.
-TABLE_SUFFIXES = (".parquet", ".csv")
+__all__ = ["TABLE_SUFFIXES", "claims_grid", "headline", "write_table"]
 
 
 def claim_order(claims: pd.Series) -> pd.Series:
@@ -78,11 +77,4 @@ def headline(grid: pd.DataFrame, runs: list[str]) -> tuple[pd.DataFrame, pd.Data
 
 def write_table(grid: pd.DataFrame, path: Path) -> None:
     """``grid`` as Parquet or CSV (by ``path``'s suffix), written atomically; another suffix is a ValueError."""
-    if path.suffix not in TABLE_SUFFIXES:
-        raise ValueError(f"--out {path}: the table is written as {' or '.join(TABLE_SUFFIXES)}")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(path) as tmp:
-        if path.suffix == ".parquet":
-            grid.to_parquet(tmp, index=False)
-        else:
-            grid.to_csv(tmp, index=False)
+    write_table_file(grid, path)
