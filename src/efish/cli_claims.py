@@ -73,6 +73,7 @@ def run_power(args, cfg, started) -> None:
     from .bench.timing import machine, machine_line
     from .claims.planner import part_models, plan_table, power_curves, read_run, with_stages
     from .claims.power_page import CLAIM_SUMMARY_COLUMNS, claim_summary, headline, power_markdown
+    from .claims.report import recorded_alpha
     from .figures.power import plot_power
     from .io import read_parquet, write_parquet_tables, write_text_atomic
     from .layout import Run
@@ -80,7 +81,8 @@ def run_power(args, cfg, started) -> None:
     run = run_of(cfg, args.overrides)
     if args.results is not None:
         run = Run(args.results.name, results_root=args.results.parent)
-    alpha = cfg.analysis.claims_alpha
+    # the alpha the run's claims were decided at (the config.yaml efish claims wrote beside them), else the config's
+    alpha = recorded_alpha(run.path(CLAIMS_TABLE)) or cfg.analysis.claims_alpha
     tables, costs = read_run(run, alpha)  # everything read (and checked) before anything is written
     claims = (read_parquet(run.path(CLAIMS_TABLE), "the run's claims table")
               if run.path(CLAIMS_TABLE).is_file() else None)

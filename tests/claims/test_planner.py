@@ -203,3 +203,15 @@ def test_more_episodes_help_where_the_spread_is_within_seeds_and_not_where_seeds
     assert between["seeds_holds_at_2delta_more_episodes"] >= 0.9 * between["seeds_holds_at_2delta"]
     k = int(between["seeds_holds_at_2delta_more_episodes"])
     assert between["cpu_hours_holds_at_2delta_more_episodes"] == pytest.approx(k * (400 + 20 + 4 * 180) / 3600)
+
+
+def test_the_plan_uses_the_alpha_the_runs_claims_were_decided_at(tmp_path):
+    run = write_run(tmp_path / "results", {2: 0.3, 5: 0.25, 1: 0.35})
+    out = tmp_path / "power"
+    assert main(["power", "scale=laptop", "--results", str(run.results), "--out", str(out),
+                 "--figures", str(tmp_path / "figures")]) == 0
+    at_05 = pd.read_parquet(out / "power.parquet")["seeds_holds_at_2delta"].iloc[0]
+    run.path(CLAIMS_TABLE).with_name("config.yaml").write_text("analysis:\n  claims_alpha: 0.01\n")
+    assert main(["power", "scale=laptop", "--results", str(run.results), "--out", str(out),
+                 "--figures", str(tmp_path / "figures")]) == 0
+    assert pd.read_parquet(out / "power.parquet")["seeds_holds_at_2delta"].iloc[0] > at_05  # stricter: more seeds

@@ -106,7 +106,7 @@ def load_claims(where: str | Path, results_root: str | Path = RESULTS_ROOT) -> t
                          "(run efish claims first)")
     run = path.parent.parent.name if path.parent.name == "claims" else path.parent.name
     table = read_parquet(path, f"the claims table {path}")
-    table.attrs[ALPHA_ATTR] = _alpha_beside(path)
+    table.attrs[ALPHA_ATTR] = recorded_alpha(path)
     return run, table
 
 
@@ -114,7 +114,7 @@ def load_claims(where: str | Path, results_root: str | Path = RESULTS_ROOT) -> t
 ALPHA_ATTR = "claims_alpha"
 
 
-def _alpha_beside(path: Path) -> float | None:
+def recorded_alpha(path: Path) -> float | None:
     """``analysis.claims_alpha`` of the config.yaml efish claims writes beside a claims table; None without it."""
     import yaml
 
