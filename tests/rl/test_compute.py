@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import json
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
 
 import pytest
 import torch
@@ -15,8 +18,18 @@ from efish.rl.train import CHECKPOINT, train
 from .test_train import TINY, tiny, weights
 
 
-def fake_rates(fp32: float, bf16: float):
-    return lambda shape, device: {"fp32": fp32, "bf16": bf16}
+def fake_rates(fp32: float, bf16: float, calls: list | None = None):
+    def rates(shape, device, **timing):
+        if calls is not None:
+            calls.append(shape)
+        return {"fp32": fp32, "bf16": bf16}
+    return rates
+
+
+@pytest.fixture(autouse=True)
+def own_precision_cache(monkeypatch, tmp_path):
+    """Each test times its machine anew: a timing kept by one test (faked rates) must not decide another's."""
+    monkeypatch.setattr(compute_mod, "precision_cache", lambda: tmp_path / "precision")
 
 
 def test_an_explicit_precision_is_taken_without_timing(monkeypatch):
@@ -35,6 +48,44 @@ def test_auto_takes_bf16_only_when_clearly_faster(monkeypatch, fp32, bf16, chose
     # the GEMM of the training shapes: one pass's sequences x width, times width x 3 width (the GRU)
     assert c.gemm_shape == (pass_sequences(cfg), 16, 48)
     assert c.record()["gemm_gflops"] == {"fp32": fp32 / 1e9, "bf16": bf16 / 1e9}
+
+
+def test_auto_times_a_machine_once_and_keeps_it(monkeypatch, tmp_path):
+    calls = []
+    monkeypatch.setattr(compute_mod, "gemm_rates", fake_rates(100e9, 250e9, calls))
+    first = resolve_compute(tiny(1))
+    monkeypatch.setattr(compute_mod, "gemm_rates", fake_rates(100e9, 20e9, calls))  # load beside the next start
+    again = resolve_compute(tiny(2))
+    assert len(calls) == 1 and first.precision == again.precision == "bf16"  # the kept timing, not the loaded one
+    kept = json.loads(Path(again.timing).read_text())
+    assert Path(again.timing).parent == tmp_path / "precision" and kept["gemm_flops"] == {"fp32": 100e9, "bf16": 250e9}
+    assert kept["threads"] == torch.get_num_threads() and kept["shape"] == list(again.gemm_shape)
+    assert again.record()["gemm_timing"] == again.timing
+
+
+def test_another_machine_or_shape_is_timed_anew(monkeypatch):
+    calls = []
+    monkeypatch.setattr(compute_mod, "gemm_rates", fake_rates(100e9, 250e9, calls))
+    resolve_compute(tiny(1))
+    resolve_compute(tiny(1, "train.hidden=32"))  # another GEMM shape
+    identity = compute_mod.machine_identity
+    monkeypatch.setattr(compute_mod, "machine_identity", lambda shape, device: {**identity(shape, device), "cpu": "x"})
+    resolve_compute(tiny(1))
+    assert [shape[1] for shape in calls] == [16, 32, 16]
+
+
+def test_seeds_starting_together_wait_for_one_timing(monkeypatch):
+    calls = []
+
+    def slow_rates(shape, device, **timing):
+        calls.append(shape)
+        time.sleep(0.3)  # a second start arrives while the first times
+        return {"fp32": 100e9, "bf16": 250e9}
+
+    monkeypatch.setattr(compute_mod, "gemm_rates", slow_rates)
+    with ThreadPoolExecutor(2) as pool:
+        answers = list(pool.map(lambda _: compute_mod.machine_rates((8, 16, 48), torch.device("cpu"))[0], range(2)))
+    assert len(calls) == 1 and answers[0] == answers[1]
 
 
 def test_gemm_rates_times_both_precisions():

@@ -4,8 +4,9 @@ MFU = achieved model FLOP/s of the PPO update / peak GEMM FLOP/s measured in the
 same run at the same dtype (fp32 and bf16). Model FLOPs are counted
 analytically: 2 per multiply-add of every Linear and GRU matrix, backward = 2 x
 forward. Each width also reports the GEMM of its training shapes in both
-precisions, the measurement ``train.precision=auto`` decides by, and which
-precision auto would take.
+precisions, the measurement ``train.precision=auto`` decides by (timed anew
+here; training keeps each machine's first: efish.rl.compute.machine_rates),
+and which precision auto would take by it.
 
 The GEMMs are timed first: they are cheap, and a precision whose training-shape
 GEMM runs below ``bench.train_skip_below`` of the fastest one's is not timed

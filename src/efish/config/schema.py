@@ -319,7 +319,7 @@ class TrainConfig:
                           "metrics.parquet: csv (metrics.csv), tensorboard (tensorboard/; needs the tensorboard "
                           "extra); [] = neither", choices=("csv", "tensorboard"), neutral=True)
     precision: str = param("auto", "arithmetic of the update's forward passes: fp32, bf16 autocast, or auto (time "
-                           "the training GEMM in both at start, take the faster; recorded in provenance.json)",
+                           "the training GEMM in both once per machine, take the faster; recorded in provenance.json)",
                            choices=("auto", "fp32", "bf16"))
     bf16_speedup: float = param(1.2, "auto takes bf16 only when its GEMM runs at least this many times as fast as "
                                 "fp32 (near ties keep fp32's numerics)", lo=1.0, neutral=True)
