@@ -73,7 +73,7 @@ def run_power(args, cfg, started) -> None:
     from .bench.timing import machine, machine_line
     from .claims.planner import part_models, plan_table, power_curves, read_run, with_stages
     from .claims.power_page import CLAIM_SUMMARY_COLUMNS, claim_summary, headline, power_markdown
-    from .claims.report import recorded_alpha
+    from .claims.report import recorded_alpha, recorded_setting
     from .figures.power import plot_power
     from .io import read_parquet, write_parquet_tables, write_text_atomic
     from .layout import Run
@@ -83,7 +83,10 @@ def run_power(args, cfg, started) -> None:
         run = Run(args.results.name, results_root=args.results.parent)
     # the alpha the run's claims were decided at (the config.yaml efish claims wrote beside them), else the config's
     alpha = recorded_alpha(run.path(CLAIMS_TABLE)) or cfg.analysis.claims_alpha
-    tables, costs = read_run(run, alpha)  # everything read (and checked) before anything is written
+    # the episodes per condition of the selected seed and of the other top seeds' reruns, recorded there too
+    episodes, rerun = (recorded_setting(run.path(CLAIMS_TABLE), "scale", key) or getattr(cfg.scale, key)
+                       for key in ("max_episodes", "top_seed_episodes"))
+    tables, costs = read_run(run, alpha, (episodes, min(rerun, episodes)))  # all read before anything is written
     claims = (read_parquet(run.path(CLAIMS_TABLE), "the run's claims table")
               if run.path(CLAIMS_TABLE).is_file() else None)
     recipe = (read_parquet(run.path(RECIPE_PARTS), "the recipe's parts table")

@@ -7,6 +7,7 @@ import pandas as pd
 import pytest
 from scipy import stats
 
+from efish.claims.intervals import signed_rank_interval
 from efish.claims.planner import (
     CURVE_COLUMNS,
     CURVE_SEEDS,
@@ -19,11 +20,19 @@ from efish.claims.planner import (
     power_curves,
     run_costs,
 )
-from efish.claims.power import decision_probabilities
+from efish.claims.power import (
+    SIGNED_RANK,
+    decision_probabilities,
+    own_decision_probabilities,
+    own_standard_error,
+    units_needed,
+)
 from efish.cli import main
 from efish.layout import CLAIM_PARTS, CLAIMS_BY_STAGE, CLAIMS_TABLE, CLAIMS_TRENDS, RANKING, RECIPE_PARTS, Run
 
 ALPHA = 0.05
+#: The ci_method of a t interval over a seed's units (C4's, a t-test over episodes).
+T_METHOD = f"inverts the clustered t-test, level {1 - 2 * ALPHA:.3g}"
 
 
 def parts_table(rng, seed_effects: dict[str, float], tau: float, sigma: float, n: int, delta: float) -> pd.DataFrame:
@@ -34,7 +43,7 @@ def parts_table(rng, seed_effects: dict[str, float], tau: float, sigma: float, n
         data = rng.normal(rng.normal(true, tau), sigma, n)
         half = stats.t.ppf(1 - ALPHA, n - 1) * data.std(ddof=1) / np.sqrt(n)
         rows.append({"claim": "C9", "part": part, "sign": 1.0, "effect": data.mean(), "ci_low": data.mean() - half,
-                     "ci_high": data.mean() + half, "ci_method": "t", "n": n, "family": 1, "delta": delta,
+                     "ci_high": data.mean() + half, "ci_method": T_METHOD, "n": n, "family": 1, "delta": delta,
                      "verdict": "inconclusive"})
     return pd.DataFrame(rows)
 
@@ -215,3 +224,72 @@ def test_the_plan_uses_the_alpha_the_runs_claims_were_decided_at(tmp_path):
     assert main(["power", "scale=laptop", "--results", str(run.results), "--out", str(out),
                  "--figures", str(tmp_path / "figures")]) == 0
     assert pd.read_parquet(out / "power.parquet")["seeds_holds_at_2delta"].iloc[0] > at_05  # stricter: more seeds
+
+
+def ranked_parts(rng, true: float, sigma: float, n: int, delta: float, seeds=(3, 1, 4, 2)) -> dict[int, pd.DataFrame]:
+    """Each seed's claim_parts row of one paired part, as the claims make it: n differences with SD sigma around
+    ``true``, the signed-rank test's Hodges-Lehmann interval at 1 - 2 alpha."""
+    tables = {}
+    for seed in seeds:
+        interval = signed_rank_interval(rng.normal(true, sigma, n), 2 * ALPHA)
+        tables[seed] = pd.DataFrame([{
+            "claim": "C10", "part": "food", "sign": -1.0, "effect": interval.estimate, "ci_low": interval.low,
+            "ci_high": interval.high, "ci_method": f"inverts the signed-rank test, level {1 - 2 * ALPHA:.3g}",
+            "n": n, "family": 1, "delta": delta, "verdict": "inconclusive"}])
+    return tables
+
+
+def test_the_selected_seeds_own_test_is_planned_at_its_episodes_and_priced_per_episode():
+    """A paired part over 8 episodes: the own columns are the signed-rank plan at the seeds' sigma, the episodes
+    named are the first that reach 80%, and they cost what the reruns cost per episode."""
+    costs = COSTS._replace(episodes=8.0, rerun_episodes=6.0)
+    row = plan_parts(ranked_parts(np.random.default_rng(11), -0.05, 0.3, 8, 0.1), ALPHA, costs).iloc[0]
+    assert row["own_test"] == "signed-rank" and row["own_units"] == 8
+    sigma = row["sigma"]
+    plan = {k: own_decision_probabilities(-0.2 * (k == "holds"), sigma, 8, SIGNED_RANK, -1, 0.1, ALPHA)[k]
+            for k in ("holds", "absent")}
+    assert (row["own_now_holds_at_2delta"], row["own_now_absent_at_0"]) == pytest.approx(
+        (plan["holds"], plan["absent"]))
+    for key, theta, sought in (("holds_at_2delta", -0.2, "holds"), ("absent_at_0", 0.0, "absent")):
+        k = int(row[f"own_episodes_{key}"])
+        chances = [own_decision_probabilities(theta, sigma, n, SIGNED_RANK, -1, 0.1, ALPHA)[sought] for n in (k - 1, k)]
+        assert chances[0] < 0.8 <= chances[1], key
+        assert row[f"own_cpu_hours_{key}"] == pytest.approx(k * 180 / 6 / 3600)  # 180 s of reruns at 6 episodes
+    assert row["own_episodes_holds_at_2delta"] > 8 and row["own_now_holds_at_2delta"] < 0.8
+
+
+def test_own_episodes_follow_the_selected_seeds_units_per_episode():
+    """A part over 16 units at 8 episodes a condition (two conditions' episodes, say) needs half as many episodes
+    per condition as units; one seed alone still plans its own test from its own interval."""
+    tables = ranked_parts(np.random.default_rng(12), 0.0, 0.3, 16, 0.1, seeds=(3,))
+    row = plan_parts(tables, ALPHA, COSTS._replace(episodes=8.0, rerun_episodes=8.0)).iloc[0]
+    assert np.isnan(row["seeds_holds_at_2delta"]) and "1 seed(s)" in row["note"]
+    units = units_needed(-0.2, float(own_standard_error(tables[3]["ci_low"][0], tables[3]["ci_high"][0], SIGNED_RANK,
+                                                        16, ALPHA) * 4), SIGNED_RANK, -1, 0.1, ALPHA, "holds")
+    assert row["own_episodes_holds_at_2delta"] == np.ceil(units / 2)
+
+
+def test_a_part_whose_own_test_makes_no_interval_is_not_planned_and_says_why():
+    rng = np.random.default_rng(13)
+    tables = {s: parts_table(rng, {"p": 0.3}, 0.05, 0.2, 8, 0.1).assign(ci_method="") for s in (1, 2, 3)}
+    row = plan_parts(tables, ALPHA, COSTS).iloc[0]
+    assert row["own_test"] == "" and np.isnan(row["own_now_holds_at_2delta"]) and "no interval" in row["note"]
+    assert np.isfinite(row["now_holds_at_2delta"])  # the recipe's plan does not need it
+
+
+def test_power_command_prices_the_selected_seeds_episodes_at_the_recorded_episodes(tmp_path):
+    """The episodes per condition come from the config.yaml the run's claims recorded (here 8 for the selected seed,
+    4 for the reruns), and an episode costs the reruns' CPU time over their episodes."""
+    run = write_run(tmp_path / "results", {2: 0.3, 5: 0.25, 1: 0.35})
+    for seed in (5, 1):
+        benchmark(run.top_seed(seed).benchmark("claims"), 60.0)
+    run.path(CLAIMS_TABLE).with_name("config.yaml").write_text(
+        "analysis:\n  claims_alpha: 0.05\nscale:\n  max_episodes: 8\n  top_seed_episodes: 4\n")
+    out = tmp_path / "power"
+    assert main(["power", "scale=laptop", "--results", str(run.results), "--out", str(out),
+                 "--figures", str(tmp_path / "figures")]) == 0
+    row = pd.read_parquet(out / "power.parquet").iloc[0]
+    assert row["own_test"] == "t" and row["own_units"] == 8
+    episodes = int(row["own_episodes_holds_at_2delta"])
+    assert row["own_cpu_hours_holds_at_2delta"] == pytest.approx(episodes * 60 / 4 / 3600)
+    assert "| t | " in (out / "power.md").read_text()

@@ -7,9 +7,14 @@ import pytest
 
 from efish.claims.decision import over_seeds
 from efish.claims.power import (
+    RANK_SUM,
+    SIGNED_RANK,
+    T_TEST,
     Components,
     components,
     decision_probabilities,
+    own_decision_probabilities,
+    own_tail,
     scenario_verdict,
     seeds_needed,
     standard_error,
@@ -112,3 +117,20 @@ def test_bad_designs_are_one_line_errors(bad):
     args = dict(theta=0.0, sd=0.1, seeds=4, sign=1, delta=DELTA, alpha=ALPHA) | bad
     with pytest.raises(ValueError):
         decision_probabilities(**args)
+
+
+def test_the_signed_rank_intervals_level_is_its_exact_one():
+    """At 8 differences the signed-rank interval at 90% ends where P(T+ <= 5) = 10 / 256 (not 0.05); at 4 it cannot
+    reject at all (2 / 2^4 = 0.125 > 0.1), so the part is not decidable; beyond 50 scipy's p is the normal one."""
+    assert own_tail(SIGNED_RANK, 8, ALPHA) == pytest.approx(10 / 256)
+    assert own_tail(SIGNED_RANK, 4, ALPHA) == 0.0
+    assert own_decision_probabilities(0.5, 0.1, 4, SIGNED_RANK, +1, DELTA, ALPHA)["not decidable"] == 1.0
+    assert own_tail(SIGNED_RANK, 60, ALPHA, family=2) == ALPHA / 2
+    assert own_tail(RANK_SUM, 3, ALPHA) == 0.0 and own_tail(RANK_SUM, 4, ALPHA) == pytest.approx(2 / 70)
+
+
+def test_a_t_interval_over_units_is_planned_as_over_seeds():
+    """The own plan of a t interval over n units is the recipe's over n seeds: the same noncentral t."""
+    for sign, theta in ((+1, 2 * DELTA), (0, 0.0), (None, 0.05)):
+        own = own_decision_probabilities(theta, 0.3, 9, T_TEST, sign, DELTA, ALPHA, family=2)
+        assert own == pytest.approx(decision_probabilities(theta, 0.3, 9, sign, DELTA, ALPHA, family=2))

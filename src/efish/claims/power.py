@@ -30,16 +30,27 @@ planner asks two questions that can be answered: how likely the verdict is
 **holds** if the true effect is twice delta in the paper's direction, and how
 likely it is **absent** if there is no effect (:data:`SCENARIOS`), and for each
 the fewest seeds that reach :data:`TARGET` (80%, the convention of power
-analysis: Cohen 1988). Pure scipy: nothing here reads a table.
+analysis: Cohen 1988).
+
+The selected seed's own verdict of a part is its part's own test over that
+seed's units (episodes), against the same delta; its spread is sigma alone.
+:func:`own_decision_probabilities` plans it for the test the part uses
+(:class:`OwnTest`): exactly for a t interval, and for a rank test's
+Hodges-Lehmann interval by the t interval over the same units at the rank
+test's exact level (:func:`own_tail`), a normal approximation that the
+simulated check in tests/claims/test_power.py holds against the real test;
+:func:`units_needed` finds the fewest units that reach the target. Pure scipy:
+nothing here reads a table.
 """
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from typing import NamedTuple
 
 import numpy as np
-from scipy import stats
+from scipy import special, stats
 
 #: The chance of a decisive verdict a design should reach (the conventional power of 80%).
 TARGET = 0.8
@@ -95,19 +106,28 @@ def _critical(seeds: int, alpha: float, family: int) -> float:
     return float(stats.t.ppf(1 - alpha / family, seeds - 1))
 
 
-def _seeds_sds(sd: float, seeds: int) -> np.ndarray:
-    """:data:`QUADRATURE` equally likely values of the SD of ``seeds`` normal effects of SD ``sd`` (the midpoints of
-    as many equal slices of its distribution: s^2 (k - 1) / sd^2 is chi-square with k - 1 df), so that a mean
-    over them is an expectation over s."""
+@functools.lru_cache(maxsize=1024)
+def _chi_quantiles(df: int) -> np.ndarray:
+    """:data:`QUADRATURE` equally likely values of s / sd for an SD s of ``df`` degrees of freedom (the midpoints of
+    as many equal slices of its distribution: s^2 df / sd^2 is chi-square with df degrees of freedom), so that a
+    mean over them is an expectation over s. Cached: a design search asks for the same df again and again."""
     u = (np.arange(QUADRATURE) + 0.5) / QUADRATURE
-    return sd * np.sqrt(stats.chi2.ppf(u, seeds - 1) / (seeds - 1))
+    out = np.sqrt(stats.chi2.ppf(u, df) / df)
+    out.flags.writeable = False
+    return out
 
 
-def _mean_in(theta: float, sd: float, seeds: int, lo: np.ndarray, hi: np.ndarray) -> float:
-    """P(lo(s) < the seeds' mean < hi(s)), averaged over the seeds' SD s (``lo``, ``hi`` at each of its
-    :func:`_seeds_sds` values): the mean of normal effects is N(theta, sd^2 / k) and independent of their SD."""
-    se = sd / np.sqrt(seeds)
-    inside = stats.norm.cdf((hi - theta) / se) - stats.norm.cdf((lo - theta) / se)
+def _seeds_sds(sd: float, seeds: int) -> np.ndarray:
+    """:data:`QUADRATURE` equally likely values of the SD of ``seeds`` normal effects of SD ``sd``
+    (:func:`_chi_quantiles` with k - 1 degrees of freedom)."""
+    return sd * _chi_quantiles(seeds - 1)
+
+
+def _mean_in(theta: float, se: float, lo: np.ndarray, hi: np.ndarray) -> float:
+    """P(lo(s) < the estimate < hi(s)), averaged over the equally likely values s of the interval's spread (``lo``,
+    ``hi`` at each of them): the estimate is N(theta, se^2) and independent of that spread (the mean of normal
+    values is independent of their SD)."""
+    inside = special.ndtr((hi - theta) / se) - special.ndtr((lo - theta) / se)  # the normal CDF, as a bare ufunc
     return float(np.clip(np.where(hi > lo, inside, 0.0).mean(), 0.0, 1.0))
 
 
@@ -120,14 +140,20 @@ def decision_probabilities(theta: float, sd: float, seeds: int, sign: int | None
         raise ValueError(f"a decision over seeds needs at least 2 seeds, not {seeds}")
     if not (delta > 0 and sd > 0):
         raise ValueError(f"delta and the seeds' SD must be positive, got {delta} and {sd}")
-    c = _critical(seeds, alpha, family)
     root = np.sqrt(seeds)
+    half = _critical(seeds, alpha, family) * _seeds_sds(sd, seeds) / root  # at each value of the seeds' SD
+    return _decisions(theta, sd / root, half, sign, delta)
+
+
+def _decisions(theta: float, se: float, half: np.ndarray, sign: int | None, delta: float) -> dict[str, float]:
+    """The chance of each decision of :func:`efish.claims.decision.decide` for an interval estimate +- ``half``
+    whose estimate is N(``theta``, ``se``^2), ``half`` its equally likely half-widths (one value for an interval of
+    known width). Keys: holds, absent, opposite, inconclusive, not decidable; they sum to 1."""
     t = -theta if sign is not None and sign < 0 else theta  # the paper's direction positive
-    half = c * _seeds_sds(sd, seeds) / root  # the interval's half-width at each value of the seeds' SD
     inf = np.full_like(half, np.inf)
 
     def chance(lo: np.ndarray, hi: np.ndarray) -> float:
-        return _mean_in(t, sd, seeds, lo, hi)
+        return _mean_in(t, se, lo, hi)
 
     beyond = chance(delta + half, inf)       # low > +delta
     against = chance(-inf, -delta - half)    # high < -delta
@@ -173,3 +199,174 @@ def seeds_needed(components_: Components, sign: int | None, delta: float, alpha:
         lo, hi = (lo, mid) if chance(mid) >= target else (mid, hi)
     return hi
 
+
+
+# ------------------------------------------------------------------ the selected seed's own test
+class OwnTest(NamedTuple):
+    """A part's own test over its units (episodes, or other units) as the planner models its interval
+    (:func:`own_decision_probabilities`): the estimate is normal with standard error sigma / sqrt(n), and the
+    interval's half-width is the critical value times an estimated standard error of ``df_per_unit`` x n -
+    ``df_lost`` degrees of freedom, as a t interval's is (``df_per_unit`` 0: a normal interval of known width).
+    ``rank``: the interval inverts a rank test, whose level at small n is its exact one (:func:`own_tail`)."""
+
+    name: str
+    df_per_unit: int
+    df_lost: int
+    rank: bool = False
+
+    def df(self, units: int) -> int:
+        """The degrees of freedom of the interval's spread at ``units`` units (0: known width)."""
+        return self.df_per_unit * units - self.df_lost if self.df_per_unit else 0
+
+
+#: The signed-rank test of n paired (or one-sample) differences: the Hodges-Lehmann interval, modelled as a t
+#: interval over the n differences at the rank test's exact level (:func:`own_tail`).
+SIGNED_RANK = OwnTest("signed-rank", 1, 1, rank=True)
+#: Mann-Whitney of two groups of n units each (n: the first group's, the other assumed as large): the
+#: Hodges-Lehmann shift, modelled as a pooled two-sample t interval (2n - 2 df) at the rank test's exact level.
+RANK_SUM = OwnTest("Mann-Whitney", 2, 2, rank=True)
+#: A t interval over n units (a one-sample or clustered t-test; a jackknife t interval).
+T_TEST = OwnTest("t", 1, 1)
+#: Welch's t of two groups, n units in all (n / 2 each).
+WELCH = OwnTest("Welch t", 1, 2)
+#: The t-test of one coefficient of a regression with 4 coefficients over n units (C17's interaction).
+REGRESSION_T = OwnTest("regression t", 1, 4)
+#: Spearman's rho by Fisher's z: a normal interval on the z scale of known width sqrt((1 + r^2 / 2) / (n - 3))
+#: (Bonett and Wright's), r the true correlation.
+FISHER_Z_TEST = OwnTest("Fisher z", 0, 3)
+#: A percentile bootstrap over units: a normal interval of known width z sigma / sqrt(n).
+NORMAL = OwnTest("normal", 0, 0)
+#: The most units a search of :func:`units_needed` tries before it answers "beyond reach".
+MAX_UNITS = 100_000
+#: Up to this many units scipy computes a signed-rank p exactly (method "auto"); Mann-Whitney's up to
+#: :data:`EXACT_RANK_SUM` units in a group. Beyond, its normal approximation: the interval's level is the nominal one.
+EXACT_SIGNED_RANK, EXACT_RANK_SUM = 50, 8
+
+
+def _signed_rank_null(n: int) -> np.ndarray:
+    """P(T+ = t), t = 0 .. n(n + 1) / 2: the signed-rank statistic of n untied differences under no effect (each
+    sign flips alone; counted by convolution over the ranks)."""
+    counts = np.zeros(n * (n + 1) // 2 + 1)
+    counts[0] = 1.0
+    for rank in range(1, n + 1):
+        counts[rank:] = counts[rank:] + counts[:-rank]  # the right side first: each flip counted once
+    return counts / 2.0 ** n
+
+
+def _rank_sum_null(m: int, n: int) -> np.ndarray:
+    """P(U = u), u = 0 .. m n: the Mann-Whitney statistic of untied samples of m and n under no effect (the orderings
+    counted by the recurrence on which sample holds the largest value)."""
+    previous = [np.ones(1)] * (n + 1)  # counts for a first sample of a - 1 values and 0 .. n others
+    for a in range(1, m + 1):
+        current = [np.ones(1)]
+        for b in range(1, n + 1):
+            counts = np.zeros(a * b + 1)
+            counts[b:b + previous[b].size] += previous[b]   # its largest value is the first sample's: U grows by b
+            counts[:current[b - 1].size] += current[b - 1]  # it is the other's
+            current.append(counts)
+        previous = current
+    return previous[n] / previous[n].sum()
+
+
+def _exact_tail(null: np.ndarray, two_sided: float) -> float:
+    """The one-sided level of the interval that inverts a two-sided exact rank test of null distribution ``null``
+    (symmetric) at ``two_sided``: the shifts it keeps end at the order statistic c + 1, c the largest statistic
+    below the middle whose p 2 P(S <= c) stays under ``two_sided``, so each side excludes P(S <= c); 0 when no
+    statistic can reject (the interval is unbounded)."""
+    below = np.cumsum(null)[: (null.size - 1) // 2 + 1]
+    rejected = below[2 * below < two_sided]
+    return float(rejected[-1]) if rejected.size else 0.0
+
+
+@functools.lru_cache(maxsize=4096)
+def own_tail(test: OwnTest, units: int, alpha: float, family: int = 1) -> float:
+    """The one-sided level of ``test``'s interval at ``units`` units: alpha / ``family`` (the interval at 1 - 2 alpha /
+    family), or for a rank test where scipy computes its p exactly (:data:`EXACT_SIGNED_RANK`,
+    :data:`EXACT_RANK_SUM`) the level its interval really has. A discrete test cannot reject at exactly alpha, so
+    its interval is wider than nominal: at 8 differences and alpha 0.05 the signed-rank interval excludes 0.039 a
+    side, not 0.05, and a t model at the nominal level would promise 5 points more than the test delivers (the
+    simulated check in tests/claims/test_power.py). 0 where the test cannot reject at all. Cached: a design search
+    asks for the same level again and again."""
+    nominal = alpha / family
+    if test == SIGNED_RANK and units <= EXACT_SIGNED_RANK:
+        return _exact_tail(_signed_rank_null(units), 2 * nominal)
+    if test == RANK_SUM and units <= EXACT_RANK_SUM:
+        return _exact_tail(_rank_sum_null(units, units), 2 * nominal)
+    return nominal
+
+
+def own_min_units(test: OwnTest) -> int:
+    """The fewest units ``test`` is planned at: 2 (a part's least), one more than its interval's lost degrees of
+    freedom, 4 for Fisher's z (its standard error needs n > 3)."""
+    return max(2, test.df_lost + 1, 4 if test == FISHER_Z_TEST else 0)
+
+
+def own_decision_probabilities(theta: float, sigma: float, units: int, test: OwnTest, sign: int | None,
+                               delta: float, alpha: float, family: int = 1) -> dict[str, float]:
+    """The chance of each decision of a part's own test over ``units`` units (the selected seed's verdict,
+    :func:`efish.claims.verdicts.decide_outcome`) when its true effect is ``theta`` and one unit's contribution
+    has SD ``sigma`` (both on the scale decided on: Fisher's z for a correlation). Keys as
+    :func:`decision_probabilities`.
+
+    The estimate is N(theta, sigma^2 / n) (for Fisher's z, the variance its test assumes, (1 + r^2 / 2) / (n - 3)
+    with r = tanh(theta)); the interval is the estimate +- a critical value at :func:`own_tail`'s level times an
+    estimated standard error. For a t interval this is exact (the noncentral t, as over seeds). A rank test's
+    interval has no closed-form power: its Hodges-Lehmann interval is modelled as the t interval over the same
+    units at the rank test's exact level, with sigma on the rank estimate's own scale (the SE its interval implies
+    times sqrt(n), :func:`own_standard_error`; for normal data sqrt(pi / 3) times the data's SD). The simulated
+    check in tests/claims/test_power.py puts it within 2 percentage points of the real test at 6-16 units."""
+    if units < own_min_units(test):
+        raise ValueError(f"the {test.name} test is planned from {own_min_units(test)} units, not {units}")
+    if not (delta > 0 and (sigma > 0 or test == FISHER_Z_TEST)):
+        raise ValueError(f"delta and sigma must be positive, got {delta} and {sigma}")
+    tail = own_tail(test, units, alpha, family)
+    if tail <= 0:  # the test cannot reject at this n: its interval is unbounded
+        return dict.fromkeys(("holds", "absent", "opposite", "inconclusive"), 0.0) | {"not decidable": 1.0}
+    if test == FISHER_Z_TEST:
+        se = float(np.sqrt((1 + np.tanh(theta) ** 2 / 2) / (units - 3)))
+    else:
+        se = sigma / np.sqrt(units)
+    df = test.df(units)
+    if df:
+        half = stats.t.ppf(1 - tail, df) * se * _chi_quantiles(df)
+    else:
+        half = np.array([stats.norm.ppf(1 - tail) * se])
+    return _decisions(theta, se, half, sign, delta)
+
+
+def own_standard_error(low: float, high: float, test: OwnTest, units: int, alpha: float, family: int = 1) -> float:
+    """The standard error a part's interval [low, high] implies under :func:`own_decision_probabilities`' model:
+    its half-width over the critical value it was made with (t with the test's degrees of freedom at
+    :func:`own_tail`'s level; normal for an interval of known width). Read back this way, SE^2 x n estimates
+    sigma^2 without the bias a normal quantile gives a t or rank interval at a few units (at 8 episodes a
+    signed-rank interval read with the normal quantile gives a sigma 25% too large)."""
+    tail = own_tail(test, units, alpha, family) if units >= own_min_units(test) else 0.0
+    if tail <= 0:
+        return np.nan
+    df = test.df(units)
+    critical = stats.t.ppf(1 - tail, df) if df else stats.norm.ppf(1 - tail)
+    return (high - low) / (2 * critical)
+
+
+def units_needed(theta: float, sigma: float, test: OwnTest, sign: int | None, delta: float, alpha: float,
+                 sought: str, family: int = 1, target: float = TARGET) -> int | None:
+    """The fewest units at which ``test``'s decision reaches ``sought`` with probability ``target``
+    (:func:`own_decision_probabilities`); None when :data:`MAX_UNITS` do not. Where the rank test's level is
+    exact (up to :data:`EXACT_SIGNED_RANK` units) the chance can dip as n grows (the level jumps with n), so
+    those n are tried one by one; beyond, the chance grows with n and a bisection finds the first."""
+    def chance(n: int) -> float:
+        return own_decision_probabilities(theta, sigma, n, test, sign, delta, alpha, family)[sought]
+
+    first = own_min_units(test)
+    linear = EXACT_SIGNED_RANK if test.rank else first
+    for n in range(first, linear + 1):
+        if chance(n) >= target:
+            return n
+    lo = max(first, linear)
+    if chance(MAX_UNITS) < target:
+        return None
+    hi = MAX_UNITS
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        lo, hi = (lo, mid) if chance(mid) >= target else (mid, hi)
+    return hi

@@ -19,10 +19,17 @@ def _chance(value) -> str:
 
 
 def _seeds(value, hours) -> str:
-    """Seeds for the target and their CPU-hours; beyond reach where no design of MAX_SEEDS seeds reaches it."""
+    """Seeds (or episodes) for the target and their CPU-hours; empty where no design reaches it."""
     if pd.isna(value):
         return ""
     return f"{int(value)} ({hours:.3g} h)" if np.isfinite(hours) else str(int(value))
+
+
+def _own(row, key: str) -> str:
+    """The selected seed's own test in one cell: its chance now and the episodes per condition (CPU-hours) that
+    reach the target, e.g. "31%; 27 (0.41 h)"."""
+    now = _chance(getattr(row, f"own_now_{key}"))
+    return f"{now}; {_seeds(getattr(row, f'own_episodes_{key}'), getattr(row, f'own_cpu_hours_{key}'))}" if now else ""
 
 
 def power_markdown(plan: pd.DataFrame, costs: RunCosts, header: str, alpha: float,
@@ -46,11 +53,14 @@ def power_markdown(plan: pd.DataFrame, costs: RunCosts, header: str, alpha: floa
              f"that the recipe's verdict (alpha {alpha:g}, Holm family counted) settles now and the {target_line()}. "
              f"These are planning figures, not verdicts: nothing here changes a claim. An empty cell: the part "
              f"could not be planned (its note says why) or no design of up to {MAX_SEEDS} seeds reaches "
-             f"{TARGET:.0%}.", "",
+             f"{TARGET:.0%}. The selected seed's own verdict, decided by its part's own test over its episodes, is "
+             f"planned from the same sigma: its chance now, and the episodes per condition (CPU-hours of rerunning the "
+             f"claims' assays at them) that reach {TARGET:.0%}.", "",
              f"{int(planned.sum())} of {len(plan)} parts planned.", "",
              "| claim | part | delta | seeds | effect | tau | sigma | holds at 2 delta: now | seeds (CPU-h) "
-             f"| the same at {MORE_EPISODES}x episodes | absent at 0: now | seeds (CPU-h) | note |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             f"| the same at {MORE_EPISODES}x episodes | absent at 0: now | seeds (CPU-h) | selected seed's test "
+             "| its holds at 2 delta: now; episodes (CPU-h) | its absent at 0: now; episodes (CPU-h) | note |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     stages = "trend" in plan.columns
     if stages:
         lines[-2] = lines[-2].rstrip(" |") + " | along training (env steps: effect) | trend |"
@@ -61,7 +71,8 @@ def power_markdown(plan: pd.DataFrame, costs: RunCosts, header: str, alpha: floa
                  _seeds(row.seeds_holds_at_2delta, row.cpu_hours_holds_at_2delta),
                  _seeds(row.seeds_holds_at_2delta_more_episodes, row.cpu_hours_holds_at_2delta_more_episodes),
                  _chance(row.now_absent_at_0),
-                 _seeds(row.seeds_absent_at_0, row.cpu_hours_absent_at_0), row.note,
+                 _seeds(row.seeds_absent_at_0, row.cpu_hours_absent_at_0), row.own_test,
+                 _own(row, "holds_at_2delta"), _own(row, "absent_at_0"), row.note,
                  *([row.stage_effects, row.trend] if stages else [])]
         lines.append("| " + " | ".join(str(c).replace("|", "/") for c in cells) + " |")
     return "\n".join(lines) + "\n"

@@ -114,15 +114,21 @@ def load_claims(where: str | Path, results_root: str | Path = RESULTS_ROOT) -> t
 ALPHA_ATTR = "claims_alpha"
 
 
-def recorded_alpha(path: Path) -> float | None:
-    """``analysis.claims_alpha`` of the config.yaml efish claims writes beside a claims table; None without it."""
+def recorded_setting(path: Path, group: str, key: str) -> float | None:
+    """``group.key`` (a number) of the config.yaml efish claims writes beside a claims table: what the run's claims
+    were computed under; None without it."""
     import yaml
 
     config = path.parent / "config.yaml"
     try:
-        return float(yaml.safe_load(config.read_text())["analysis"]["claims_alpha"])
+        return float(yaml.safe_load(config.read_text())[group][key])
     except (OSError, KeyError, TypeError, ValueError, yaml.YAMLError):
         return None
+
+
+def recorded_alpha(path: Path) -> float | None:
+    """``analysis.claims_alpha`` of the config.yaml efish claims writes beside a claims table; None without it."""
+    return recorded_setting(path, "analysis", "claims_alpha")
 
 
 def interval_header(table: pd.DataFrame) -> str:
