@@ -35,7 +35,7 @@
                                               of claims, fig2 .. fig6 (--figures, default figures/<run>/learning)
     efish compare-claims A B                  two runs' claim verdicts, seeds_agree and effects side by side
     efish compare-claims A B C --heatmap H.png  claims x runs: a table (--out) and a heatmap
-    efish power [overrides] [--results D] [--out D] [--figures D]
+    efish power [RUN] [overrides] [--results D] [--out D] [--figures D]
                                               what a decisive verdict costs: each part planned over the top seeds,
                                               priced with the run's job times -> power.parquet, power_curves.parquet,
                                               power_claims.parquet, power.md (default results/<run>/claims),
@@ -83,7 +83,7 @@ from typing import Sequence
 
 from ._version import __version__
 from .cli_claims import _sweep_runs, run_claims, run_claims_by_stage, run_compare_claims, run_power
-from .cli_support import HelpFormatter, add_command, add_overrides, run_of, see_docs, write_metadata
+from .cli_support import HelpFormatter, add_command, add_overrides, run_at, run_of, see_docs, write_metadata
 from .config import ConfigError, compose, to_yaml
 from .figures.gallery import GALLERY, MAX_WIDTH_PX
 from .layout import (
@@ -362,11 +362,14 @@ def _power_command(sub: argparse._SubParsersAction) -> None:
                      "Plan each claim part over the run's top seeds: split its effect's spread into between seeds and "
                      "within a seed, give the chance that the recipe's verdict settles (holds if the effect is twice "
                      "delta, absent if there is none) now and the seeds, priced in CPU-hours with the run's own job "
-                     "times, that reach 80%; per claim the recipe left inconclusive, what would settle it. Writes "
+                     "times, that reach 80%; the same for the selected seed's own verdict over its episodes; per "
+                     "claim the recipe left inconclusive, what would settle it. Writes "
                      "power.parquet, power_curves.parquet, power_claims.parquet and power.md (--out) and power.png "
                      "and .pdf (--figures). Nothing here changes a verdict.", "docs/claims/power.md")
-    add_overrides(pw, example="scale=laptop", note="they name the run and its alpha")
-    pw.add_argument("--results", type=Path, help="the run's results folder (default results/{run})")
+    add_overrides(pw, example="scale=laptop", note="the run itself may stand among them, as its folder "
+                  "(results/laptop) or its name under results/; else they name it", run=True)
+    pw.add_argument("--results", type=Path, help="the run's results folder (default: the run given, else "
+                                                 "results/{run} of the overrides)")
     _add_out(pw, f"folder for power.parquet, power_curves.parquet, power_claims.parquet and power.md (default "
                  f"results/{{run}}/{Path(POWER_TABLE).parent})")
     pw.add_argument("--figures", type=Path, help=f"folder for power.png and .pdf (default "
@@ -615,10 +618,7 @@ def _watch(args, cfg, started) -> None:
     from .watch import watch
 
     try:
-        where = Path(args.run)  # a run's name under --results, or its folder as the README's table spells it
-        run = Run(where.name, results_root=where.parent) if len(where.parts) > 1 else Run(args.run,
-                                                                                           results_root=args.results)
-        watch(run, args.interval, args.once, args.plot)
+        watch(run_at(args.run, args.results), args.interval, args.once, args.plot)
     except KeyboardInterrupt:  # Ctrl-C is how a live table is left: not an error
         pass
 

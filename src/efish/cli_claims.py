@@ -7,7 +7,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
-from .cli_support import run_of, write_metadata
+from .cli_support import run_at, run_of, write_metadata
 from .layout import (
     CLAIM_PARTS,
     CLAIMS_BY_STAGE,
@@ -78,7 +78,9 @@ def run_power(args, cfg, started) -> None:
     from .io import read_parquet, write_parquet_tables, write_text_atomic
     from .layout import Run
 
-    run = run_of(cfg, args.overrides)
+    if args.run is not None and args.results is not None:
+        raise ValueError(f"give the run once: {args.run} or --results {args.results}")
+    run = run_of(cfg, args.overrides) if args.run is None else run_at(args.run)
     if args.results is not None:
         run = Run(args.results.name, results_root=args.results.parent)
     # the alpha the run's claims were decided at (the config.yaml efish claims wrote beside them), else the config's
@@ -102,7 +104,8 @@ def run_power(args, cfg, started) -> None:
     summary = (claim_summary(plan, claims, recipe, costs) if claims is not None and recipe is not None
                else pd.DataFrame(columns=CLAIM_SUMMARY_COLUMNS))
     seeds = ", ".join(map(str, tables))
-    header = (f"Run {run.name} at scale {cfg.scale.name}, seeds {seeds} (the selected seed first), "
+    scale = recorded_setting(run.path(CLAIMS_TABLE), "scale", "name", str) or cfg.scale.name  # a run given by folder
+    header = (f"Run {run.name} at scale {scale}, seeds {seeds} (the selected seed first), "
               f"{started.strftime('%Y-%m-%d %H:%M UTC')}; {machine_line(machine())}.")
     written = write_parquet_tables({Path(POWER_TABLE).stem: plan, Path(POWER_CURVES).stem: curves,
                                     Path(POWER_CLAIMS).stem: summary}, out)

@@ -24,6 +24,14 @@ def run_of(cfg, overrides: Sequence[str]) -> Run:
     return Run(run_name(cfg.scale.name, [o for o in overrides if not o.startswith("scale=")]))
 
 
+def run_at(where: str | Path, results_root: Path = Path("results")) -> Run:
+    """The run ``where`` names on a command line: its folder name under ``results_root`` (smoke, laptop-453280a3),
+    or its folder as the README's table spells it (results/laptop)."""
+    where = Path(where)
+    return Run(where.name, results_root=where.parent) if len(where.parts) > 1 else Run(str(where),
+                                                                                       results_root=results_root)
+
+
 # ------------------------------------------------------------------ help text
 
 # The documentation pages the command line cites, each by its place in the site's navigation (mkdocs.yml's nav;
@@ -103,10 +111,27 @@ def add_command(sub: argparse._SubParsersAction, name: str, summary: str, descri
 OVERRIDES_EXAMPLE = "physics.image_order=2 arena=patchy70"
 
 
-def add_overrides(parser: argparse.ArgumentParser, example: str = OVERRIDES_EXAMPLE, note: str = "") -> None:
+def add_overrides(parser: argparse.ArgumentParser, example: str = OVERRIDES_EXAMPLE, note: str = "",
+                  run: bool = False) -> None:
     """The positional ``overrides`` of a command that composes the config, with one wording everywhere: Hydra's
     ``key=value`` or a config group's choice, an example for this command (``example``) and what else it reads
-    there (``note``)."""
+    there (``note``). ``run``: a command that reads a finished run also takes the run there, as its folder
+    (results/laptop) or its name (:func:`run_at`): one word that is no override (:class:`_RunAndOverrides`), kept
+    in ``args.run`` (None without it); its ``note`` says so."""
     text = (f"Hydra overrides of the config: key=value or a config group's choice, e.g. {example}"
             f"{f'; {note}' if note else ''} (efish config lists the keys)")
-    parser.add_argument("overrides", nargs="*", help=text)
+    if run:
+        parser.set_defaults(run=None)
+    parser.add_argument("overrides", nargs="*", help=text, **({"action": _RunAndOverrides} if run else {}))
+
+
+class _RunAndOverrides(argparse.Action):
+    """Positional words of a command that reads a finished run: one that is no Hydra override (no ``=``, no leading
+    ``+`` or ``~``) names the run (``args.run``), the others stay overrides; a second run is a usage error."""
+
+    def __call__(self, parser, namespace, values, option_string=None) -> None:
+        runs = [v for v in values if "=" not in v and not v.startswith(("+", "~"))]
+        if len(runs) > 1:
+            parser.error(f"one run at a time, not {', '.join(runs)}")
+        namespace.run = runs[0] if runs else None
+        setattr(namespace, self.dest, [v for v in values if v not in runs])

@@ -293,3 +293,21 @@ def test_power_command_prices_the_selected_seeds_episodes_at_the_recorded_episod
     episodes = int(row["own_episodes_holds_at_2delta"])
     assert row["own_cpu_hours_holds_at_2delta"] == pytest.approx(episodes * 60 / 4 / 3600)
     assert "| t | " in (out / "power.md").read_text()
+
+
+def test_power_takes_the_run_as_its_folder_or_its_name(tmp_path, monkeypatch, capsys):
+    """``efish power results/laptop`` (and ``efish power laptop`` from the folder above results/) reads that run, as
+    ``efish watch`` does, beside Hydra overrides; the recorded scale names it on the page."""
+    run = write_run(tmp_path / "results", {2: 0.3, 5: 0.25, 1: 0.35})
+    run.path(CLAIMS_TABLE).with_name("config.yaml").write_text("scale:\n  name: study\n")
+    monkeypatch.chdir(tmp_path)
+    assert main(["power", "results/laptop", "--figures", "figs"]) == 0
+    page = run.path(CLAIMS_TABLE).with_name("power.md")
+    assert page.is_file() and "Run laptop at scale study" in page.read_text()
+    page.unlink()
+    assert main(["power", "laptop", "scale=laptop", "--figures", "figs"]) == 0 and page.is_file()
+    assert main(["power", "results/laptop", "--results", "results/laptop"]) == 2
+    assert "give the run once" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["power", "results/laptop", "results/smoke"])
+    assert "one run at a time" in capsys.readouterr().err

@@ -114,14 +114,14 @@ def load_claims(where: str | Path, results_root: str | Path = RESULTS_ROOT) -> t
 ALPHA_ATTR = "claims_alpha"
 
 
-def recorded_setting(path: Path, group: str, key: str) -> float | None:
-    """``group.key`` (a number) of the config.yaml efish claims writes beside a claims table: what the run's claims
+def recorded_setting(path: Path, group: str, key: str, kind: type = float):
+    """``group.key`` of the config.yaml efish claims writes beside a claims table, as ``kind``: what the run's claims
     were computed under; None without it."""
     import yaml
 
     config = path.parent / "config.yaml"
     try:
-        return float(yaml.safe_load(config.read_text())[group][key])
+        return kind(yaml.safe_load(config.read_text())[group][key])
     except (OSError, KeyError, TypeError, ValueError, yaml.YAMLError):
         return None
 
