@@ -22,7 +22,8 @@ LAYERS = {
     "__init__": 0, "_version": 0, "_numba_cache": 0, "_jit": 0, "io": 0, "config": 0, "layout": 0, "units": 0,
     "drawing": 0, "senses": 0,
     "physics": 1, "sensors": 2, "env": 3, "rl": 4, "rollout": 5, "analysis": 6, "claims": 7, "figures": 8,
-    "bench": 9, "cli": 9, "compare_runs": 9, "cli_claims": 9, "cli_support": 9, "run_plan": 9, "share": 9, "sweep": 9, "watch": 9,
+    "bench": 9, "cli": 9, "compare_runs": 9, "cli_claims": 9, "cli_support": 9, "progress": 9, "run_plan": 9, "share": 9, "sweep": 9,
+    "watch": 9,
     "__main__": 10,
 }
 
@@ -133,7 +134,7 @@ def test_every_top_level_module_has_a_layer():
     ["efish.analysis." + p.stem for p in sorted((PACKAGE / "analysis").glob("*.py")) if p.stem != "__init__"],
     ["efish.claims." + p.stem for p in sorted((PACKAGE / "claims").glob("*.py")) if p.stem != "__init__"],
     ["efish.config", "efish.rollout.schema"],
-    ["efish.watch"],  # runs beside the jobs it watches (a cluster's login node): reading tables is all it does
+    ["efish.watch", "efish.progress"],  # runs beside the jobs it watches (a cluster's login node): it reads tables
 ], ids=["efish", "figures", "analysis", "claims", "config+schema", "watch"])
 def test_table_readers_load_neither_numba_nor_torch(modules):
     code = (f"import importlib, sys\nfor m in {modules!r}: importlib.import_module(m)\n"

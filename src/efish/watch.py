@@ -280,20 +280,27 @@ def plot_curves(metrics: dict[str, pd.DataFrame | None], path: Path, title: str 
 
 def watch(run: Run, interval: float = 10.0, once: bool = False, plot: Path | None = None,
           show: Callable[[str], None] = print) -> None:
-    """Show the run's table (and write ``plot``) every ``interval`` seconds until every job is finished, or once.
+    """Show the run's table (and write ``plot``) every ``interval`` seconds until every job is finished (and the
+    pipeline, where it has a line), or once.
 
     On a terminal each table replaces the last; elsewhere (a log file) they follow each other. New job folders
-    are picked up as their jobs start.
+    are picked up as their jobs start. Above the table, for a run of a shipped scale in the workflow's
+    ``results/`` (the current folder's), the whole pipeline's jobs done and time left (efish.progress).
     """
+    from .progress import pipeline_watch
+
     if not interval > 0:
         raise ValueError(f"--interval {interval:g} must be above 0 seconds")
     clear = "\x1b[H\x1b[2J" if sys.stdout.isatty() and not once else ""
+    pipeline = pipeline_watch(run)
     while True:
         jobs = training_jobs(run)
         metrics = {job.name: read_metrics(job) for job in jobs}
         if plot is not None:
             plot_curves(metrics, plot, f"{run.name}: training curves ({time.strftime('%Y-%m-%d %H:%M:%S')})")
-        show(clear + table(run, jobs, metrics, time.time()))
-        if once or all((job.folder / FINAL_POLICY).exists() for job in jobs):
+        head = f"{pipeline.line()}\n" if pipeline is not None else ""
+        show(clear + head + table(run, jobs, metrics, time.time()))
+        trained = all((job.folder / FINAL_POLICY).exists() for job in jobs)
+        if once or (trained and (pipeline is None or pipeline.finished)):
             return
         time.sleep(interval)

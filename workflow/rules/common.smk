@@ -41,6 +41,12 @@ def fail(message):
     sys.exit(1)
 
 
+# `efish watch`'s pipeline line counts the jobs of a whole run before the select_seed checkpoint has run, with a
+# dry run given --config planned_ranking=true: where the checkpoint's ranking is not there yet, the top seeds are
+# taken in seed order (their number, not which they are, is what the count needs). Only a dry run may plan so.
+PLANNED_RANKING = str(config.pop("planned_ranking", "false")).lower() in ("true", "1", "yes")
+
+
 # Bad input (a --config key, a run name, a config, an assay file, a sweep) stops here, in one line. Checking every
 # assay's conditions costs seconds, so each plan keeps its answer in .snakemake/efish/ for the next parse.
 try:
@@ -168,8 +174,19 @@ def stage_policy(run, seed, k):
     return results(training_file(seed_name(seed), stage_file(k)), run=Run(run))
 
 
+def planned_ranking(wildcards):
+    """The seeds in seed order, where a planning dry run (PLANNED_RANKING) finds no ranking yet; else None."""
+    if not PLANNED_RANKING or Path(results(RANKING, run=Run(wildcards.run))).exists():
+        return None
+    if not workflow.dryrun:
+        fail("--config planned_ranking=true only counts jobs: give it with --dry-run")
+    return list(plan_of(wildcards).cfg.scale.seed_numbers())
+
+
 def selected_seed(wildcards):
     """The seed the select_seed checkpoint chose."""
+    if planned := planned_ranking(wildcards):
+        return planned[0]
     return run_plan.selected_seed(checkpoints.select_seed.get(run=wildcards.run).output.seed)
 
 
@@ -196,6 +213,8 @@ def policy_args(wildcards, input):
 
 def top_seeds(wildcards):
     """The ``scale.top_seeds`` best-ranked seeds, from the select_seed checkpoint's ranking table."""
+    if planned := planned_ranking(wildcards):
+        return planned[:plan_of(wildcards).cfg.scale.top_seeds]
     return run_plan.top_seeds(checkpoints.select_seed.get(run=wildcards.run).output.ranking,
                               plan_of(wildcards).cfg.scale.top_seeds)
 
