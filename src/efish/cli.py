@@ -4,7 +4,8 @@
     efish plan [overrides]                    which effects run, and why
     efish train [overrides] [--out D]         train one seed (checkpoint.pt, metrics.parquet, final.pt)
     efish watch RUN [--results D] [--interval S] [--once] [--plot F.png]   every training job of a run in a live
-                                              table (update, return, entropy, KL, speed, ETA, state)
+                                              table (update, return, entropy, KL, speed, ETA, state), under
+                                              the whole pipeline's jobs done and time left
     efish compare-runs RUN [RUN ...] [--sweep G --scale S --overrides O] [--results D] [--out F] [--plot F.png]
                                               several runs' training curves on shared axes (each seed thin, the
                                               mean over seeds thick) and each metric's final value with a 95% t
@@ -187,7 +188,9 @@ def _training_commands(sub: argparse._SubParsersAction) -> None:
     tr.set_defaults(handler=_train, recipe=TRAINING_RECIPE)
     wa = add_command(sub, "watch", "a live table of every training job of a run",
                      "Show every training job of a run in a table refreshed in place: update, return, entropy, KL, "
-                     "speed, ETA and state, from their metrics.parquet. Writes nothing but the --plot PNG.",
+                     "speed, ETA and state, from their metrics.parquet; above it, for a shipped scale's run in this "
+                     "workflow's results/, the whole pipeline's jobs done of its total and time left (a Snakemake "
+                     "dry run every 10 minutes). Writes nothing but the --plot PNG.",
                      "docs/tutorials/watch-a-run.md", "docs/methods/training.md#live-logs")
     wa.add_argument("run", help="the run's folder name under --results (smoke, laptop-453280a3), or its folder "
                                 "(results/laptop)")
@@ -195,8 +198,8 @@ def _training_commands(sub: argparse._SubParsersAction) -> None:
     wa.add_argument("--interval", type=float, default=10.0, help="seconds between refreshes (default 10)")
     wa.add_argument("--once", action="store_true", help="print the table once and exit")
     wa.add_argument("--plot", type=Path, metavar="F.png",
-                    help="also write return, entropy and KL against env steps, one line per job, to this PNG "
-                         "(rewritten at every refresh)")
+                    help="also write every metric of the jobs' metrics against env steps, one panel each and one "
+                         "line per job, to this PNG (rewritten at every refresh)")
     wa.set_defaults(handler=_watch)  # no overrides: nothing to compose
     _compare_runs_command(sub)
     sel = add_command(sub, "select", "rank seeds by their selection episodes and choose one",
