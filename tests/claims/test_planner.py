@@ -11,6 +11,7 @@ from efish.claims.intervals import signed_rank_interval
 from efish.claims.planner import (
     CURVE_COLUMNS,
     CURVE_SEEDS,
+    MORE_EPISODES,
     PLAN_COLUMNS,
     RunCosts,
     claim_curves,
@@ -27,8 +28,18 @@ from efish.claims.power import (
     own_standard_error,
     units_needed,
 )
+from efish.claims.power_page import power_markdown
 from efish.cli import main
-from efish.layout import CLAIM_PARTS, CLAIMS_BY_STAGE, CLAIMS_TABLE, CLAIMS_TRENDS, RANKING, RECIPE_PARTS, Run
+from efish.layout import (
+    CLAIM_PARTS,
+    CLAIMS_BY_STAGE,
+    CLAIMS_TABLE,
+    CLAIMS_TRENDS,
+    RANKING,
+    RECIPE_PARTS,
+    Run,
+    top_seed_group,
+)
 
 ALPHA = 0.05
 #: The ci_method of a t interval over a seed's units (C4's, a t-test over episodes).
@@ -279,10 +290,10 @@ def test_a_part_whose_own_test_makes_no_interval_is_not_planned_and_says_why():
 
 def test_power_command_prices_the_selected_seeds_episodes_at_the_recorded_episodes(tmp_path):
     """The episodes per condition come from the config.yaml the run's claims recorded (here 8 for the selected seed,
-    4 for the reruns), and an episode costs the reruns' CPU time over their episodes."""
+    4 for the reruns), and an episode costs the reruns' CPU time over their episodes (C9's assay, patchy4, rerun
+    by both other seeds in one job of 120 s)."""
     run = write_run(tmp_path / "results", {2: 0.3, 5: 0.25, 1: 0.35})
-    for seed in (5, 1):
-        benchmark(run.top_seed(seed).benchmark("claims"), 60.0)
+    benchmark(run.benchmark(top_seed_group("patchy4")), 120.0)
     run.path(CLAIMS_TABLE).with_name("config.yaml").write_text(
         "analysis:\n  claims_alpha: 0.05\nscale:\n  max_episodes: 8\n  top_seed_episodes: 4\n")
     out = tmp_path / "power"
@@ -311,3 +322,45 @@ def test_power_takes_the_run_as_its_folder_or_its_name(tmp_path, monkeypatch, ca
     with pytest.raises(SystemExit):
         main(["power", "results/laptop", "results/smoke"])
     assert "one run at a time" in capsys.readouterr().err
+
+
+def test_a_homing_draw_is_priced_with_the_homing_jobs_not_as_a_foraging_seed(tmp_path):
+    """Planted benchmarks of a run with two more draws of the homing recipes: a draw costs its recipes' trainings and
+    its seed's rerun of homing with them (and that rerun's analyses); a foraging seed's price keeps neither."""
+    run = Run("r", results_root=tmp_path)
+    for seed, cpu in ((1, 300.0), (2, 500.0)):
+        benchmark(run.benchmark(f"train/seed_{seed}"), cpu)
+        benchmark(run.benchmark(f"selection/seed_{seed}"), 10.0)
+    for name, cpu in (("homing_draw_2", 100.0), ("homing_raycast_draw_2", 50.0), ("homing_draw_3", 120.0),
+                      ("homing_raycast_draw_3", 30.0)):
+        benchmark(run.benchmark(f"train/{name}"), cpu)
+    benchmark(run.benchmark(top_seed_group("patchy4")), 120.0)  # both other seeds' foraging rerun, one job
+    for seed, (assay, analysis) in ((2, (40.0, 10.0)), (3, (20.0, 10.0))):
+        benchmark(run.top_seed(seed).benchmark("assays/homing"), assay)  # the seed's rerun with its draw
+        benchmark(run.top_seed(seed).benchmark("analysis/dynamics/homing"), analysis)
+        benchmark(run.top_seed(seed).benchmark("analysis/behaviour/patchy4"), 5.0)
+        benchmark(run.top_seed(seed).benchmark("claims"), 20.0)
+    costs = run_costs(run, [1, 2], other_top_seeds=2, episodes=(8.0, 6.0))
+    assert costs.rerun_s == (120 + 2 * 5 + 2 * 20) / 2  # no homing in a foraging seed's reruns
+    assert (costs.draw_train_s, costs.draw_rerun_s) == (150.0, 40.0)  # per draw: both recipes; per rerunning seed
+    assert costs.drawn_assays == ("homing",) and costs.rerun_assays == ("patchy4",)
+    assert costs.draws("C2") and not costs.draws("C9") and "homing draws: training 2, reruns 2" in costs.seeds_timed
+    assert costs.design_hours(5, claim="C2") == pytest.approx(5 * (150 + 40) / 3600)
+    assert costs.design_hours(5, MORE_EPISODES, "C2") == pytest.approx(5 * (150 + 4 * 40) / 3600)
+    assert costs.design_hours(5, claim="C9") == pytest.approx(5 * (400 + 10 + 85) / 3600)
+    assert costs.episode_hours(12, "C2") == pytest.approx(12 * 40 / 6 / 3600)
+    assert costs.episode_hours(12, "C9") == pytest.approx(12 * 85 / 6 / 3600)
+    assert np.isnan(costs.episode_hours(12, "C10"))  # no top seed reran the ablations: its price is not measured
+    rng = np.random.default_rng(14)
+    tables = {s: parts_table(rng, {"aligned": 0.3}, 0.05, 0.2, 8, 0.1).assign(claim="C2") for s in (1, 2, 3)}
+    row = plan_parts(tables, ALPHA, costs).iloc[0]
+    assert row["draws"] and row["cpu_hours_holds_at_2delta"] == pytest.approx(
+        row["seeds_holds_at_2delta"] * 190 / 3600)
+    page = power_markdown(plan_parts(tables, ALPHA, costs), costs, "", ALPHA)
+    assert f"One more draw of the homing recipes, which the homing claims are decided over, costs {190 / 3600:.3g}" in page
+    # a per-seed rerun without a draw trained is not a draw's (a layout without groups): all a foraging seed's
+    for tsv in run.benchmark("train/x").parent.glob("*_draw_*.tsv"):
+        tsv.unlink()
+    plain = run_costs(run, [1, 2], other_top_seeds=2)
+    assert plain.drawn_assays == () and plain.rerun_s == (120 + 2 * 5 + 2 * 20 + 40 + 10 + 20 + 10) / 2
+    assert not plain.draws("C2") and np.isnan(plain.draw_train_s)

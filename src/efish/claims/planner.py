@@ -15,6 +15,7 @@ Pure pandas: it reads claim_parts tables and benchmark files, never the simulato
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import NamedTuple
@@ -22,7 +23,20 @@ from typing import NamedTuple
 import numpy as np
 import pandas as pd
 
-from ..layout import CLAIM_PARTS, RANKING, Run, seed_name, selection_table, top_seed_copy, training_folder
+from ..layout import (
+    CLAIM_PARTS,
+    DRAW,
+    RANKING,
+    Run,
+    assay_folder,
+    parse_recipe_draw,
+    parse_table,
+    seed_name,
+    selection_table,
+    top_seed_copy,
+    top_seed_group,
+    training_folder,
+)
 from .power import (
     FISHER_Z_TEST,
     MAX_SEEDS,
@@ -67,10 +81,11 @@ CURVE_COLUMNS = ["claim", "part", "seeds", "cpu_hours", *SCENARIO_KEYS]
 OWN_PLAN_COLUMNS = ["own_test", "own_units", "own_now_holds_at_2delta", "own_now_absent_at_0",
                     "own_episodes_holds_at_2delta", "own_episodes_absent_at_0", "own_cpu_hours_holds_at_2delta",
                     "own_cpu_hours_absent_at_0"]
-#: One row per part: the run's design (seeds, mean units per seed), the variance components, the chance of each
+#: One row per part: the run's design (seeds, whether they are draws of the homing recipes, mean units per seed), the
+#: variance components, the chance of each
 #: scenario's recipe verdict now and the seeds (and CPU-hours) that reach :data:`~efish.claims.power.TARGET`, then
 #: the selected seed's own verdict (:data:`OWN_PLAN_COLUMNS`).
-PLAN_COLUMNS = ["claim", "part", "sign", "delta", "seeds", "units", "effect", "tau", "sigma",
+PLAN_COLUMNS = ["claim", "part", "sign", "delta", "seeds", "draws", "units", "effect", "tau", "sigma",
                 "now_holds_at_2delta", "now_absent_at_0", "seeds_holds_at_2delta", "seeds_absent_at_0",
                 "cpu_hours_holds_at_2delta", "cpu_hours_absent_at_0", "seeds_holds_at_2delta_more_episodes",
                 "cpu_hours_holds_at_2delta_more_episodes", *OWN_PLAN_COLUMNS, "note"]
@@ -92,12 +107,27 @@ MORE_EPISODES = 4
 STAGE_PLAN_COLUMNS = ["stage_effects", "trend"]
 
 
+@functools.cache
+def claim_assays(claim: str) -> frozenset[str]:
+    """The assays whose tables ``claim`` reads (:data:`efish.claims.registry.CLAIMS`); none for a claim it does not
+    list."""
+    from .registry import CLAIMS
+
+    found = CLAIMS.get(claim)
+    return frozenset(t.assay for path in found.tables if (t := parse_table(path))) if found else frozenset()
+
+
 class RunCosts(NamedTuple):
     """What one more seed costs in this run, in CPU-seconds: its training, its selection episodes, and its reruns of
     the claims' assays at the run's episodes (``rerun_s``, from the other top seeds' jobs); ``seeds_timed`` says how
     many seeds each mean is over; ``run_s`` is what the whole run cost. ``episodes``: the selected seed's episodes
     per assay condition (``scale.max_episodes``), ``rerun_episodes`` the reruns' (``scale.top_seed_episodes``, at
-    most that): what :meth:`episode_hours` divides the reruns' cost by."""
+    most that): what :meth:`episode_hours` divides the reruns' cost by.
+
+    A claim whose assays act with the homing recipes alone (``drawn_assays``) is decided over draws of those
+    recipes, not over foraging seeds: one more draw costs training every drawn recipe again (``draw_train_s``) and
+    a top seed's rerun of the drawn assays with it and their analyses (``draw_rerun_s``), and neither is in a
+    foraging seed's price. ``rerun_assays``: the assays the other top seeds reran (None: not known, all of them)."""
 
     train_s: float
     selection_s: float
@@ -106,25 +136,43 @@ class RunCosts(NamedTuple):
     run_s: float = np.nan  # the whole run's CPU time (every job's benchmark file), for "x times this run"
     episodes: float = np.nan
     rerun_episodes: float = np.nan
+    draw_train_s: float = np.nan
+    draw_rerun_s: float = np.nan
+    drawn_assays: tuple[str, ...] = ()
+    rerun_assays: tuple[str, ...] | None = None
 
-    def design_hours(self, seeds: int | None, episodes: float = 1.0) -> float:
+    def draws(self, claim: str | None) -> bool:
+        """Whether ``claim``'s seeds are draws of the homing recipes: every assay it reads is a drawn one."""
+        assays = claim_assays(claim) if claim else frozenset()
+        return bool(assays) and assays <= set(self.drawn_assays)
+
+    def design_hours(self, seeds: int | None, episodes: float = 1.0, claim: str | None = None) -> float:
         """CPU-hours of a design of ``seeds`` seeds, each rerunning the claims' assays at ``episodes`` times the run's
-        episodes (training and selection do not grow with them; NaN when no design reaches it)."""
-        per_seed = self.train_s + self.selection_s + episodes * self.rerun_s
+        episodes (training and selection do not grow with them; NaN when no design reaches it); of as many draws
+        of the homing recipes where ``claim`` is decided over draws (:meth:`draws`)."""
+        if self.draws(claim):
+            per_seed = self.draw_train_s + episodes * self.draw_rerun_s
+        else:
+            per_seed = self.train_s + self.selection_s + episodes * self.rerun_s
         return np.nan if seeds is None else seeds * per_seed / 3600
 
-    def episode_hours(self, episodes: int | None) -> float:
+    def episode_hours(self, episodes: int | None, claim: str | None = None) -> float:
         """CPU-hours of the selected seed's claims' assays rerun at ``episodes`` episodes per condition: a top seed's
         measured reruns (``rerun_s``: every claim's assay that acts with the seed, their analyses and its claims
         job, at ``rerun_episodes`` a condition) scaled in proportion, ``episodes / rerun_episodes`` times their
-        cost. A line through the one measured design and no cost at no episodes: exact at the reruns' episodes,
-        and it counts each job's start-up and the claims job as if they grew with the episodes, so it overprices
-        designs of more episodes a little (the laptop reruns' jobs start in seconds and run for minutes). The
-        rerun is of every claim's assay, what ``scale.max_episodes`` asks the pipeline for, not the part's assay
-        alone. NaN where no design reaches the target or the reruns were not measured."""
-        if episodes is None or not (self.rerun_s > 0 and self.rerun_episodes > 0):
+        cost; for a claim decided over draws (:meth:`draws`), its drawn assays' reruns (``draw_rerun_s``). A line
+        through the one measured design and no cost at no episodes: exact at the reruns' episodes, and it counts
+        each job's start-up and the claims job as if they grew with the episodes, so it overprices designs of more
+        episodes a little (the laptop reruns' jobs start in seconds and run for minutes). The rerun is of every
+        claim's assay, what ``scale.max_episodes`` asks the pipeline for, not the part's assay alone. NaN where no
+        design reaches the target, the reruns were not measured, or no top seed reran ``claim``'s assays (the
+        homing assays of a run without draws)."""
+        rerun = self.draw_rerun_s if self.draws(claim) else self.rerun_s
+        known = self.rerun_assays is None or not claim or claim_assays(claim) <= {*self.rerun_assays,
+                                                                                   *self.drawn_assays}
+        if episodes is None or not (known and rerun > 0 and self.rerun_episodes > 0):
             return np.nan
-        return episodes * self.rerun_s / self.rerun_episodes / 3600
+        return episodes * rerun / self.rerun_episodes / 3600
 
 
 def _cpu_seconds(path: Path) -> float:
@@ -134,12 +182,33 @@ def _cpu_seconds(path: Path) -> float:
     return float(value) if pd.notna(value) and float(value) > 0 else float(row["s"])
 
 
+def _draw_costs(run: Run, reruns: Sequence[Path]) -> tuple[float, float, tuple[str, ...], list[Path], str]:
+    """What one more draw of the homing recipes costs (:class:`RunCosts`): the mean over the draws k of the
+    trainings of every drawn recipe (``train/<recipe>_draw_<k>``), and the mean over the top seeds that reran an
+    assay with a draw (a job of their own, ``seeds/seed_<n>/assays/<assay>``: every other rerun runs in a group)
+    of those reruns and their analyses; the drawn assays, those rerun files (not a foraging seed's) and a note."""
+    top_seeds = run.benchmarks / Path(top_seed_copy(0)).parent
+    own = [p for p in reruns if p.relative_to(top_seeds).parts[0].startswith(seed_name(""))]
+    trainings = [p for p in run.benchmark(training_folder("x")).parent.glob(f"*{DRAW}*.tsv")
+                 if parse_recipe_draw(p.stem)[1] > 1]
+    drawn = tuple(sorted({p.stem for p in own if p.parent.name == Path(assay_folder("x")).parent.name})
+                  if trainings else ())  # without a draw trained, no rerun is a draw's
+    draw_reruns = [p for p in own if p.stem in drawn]
+    draws = {parse_recipe_draw(p.stem)[1] for p in trainings}
+    rerun_seeds = {p.relative_to(top_seeds).parts[0] for p in draw_reruns}
+    train_s = sum(map(_cpu_seconds, trainings)) / len(draws) if draws else np.nan
+    rerun_s = sum(map(_cpu_seconds, draw_reruns)) / len(rerun_seeds) if rerun_seeds else np.nan
+    note = f"; homing draws: training {len(draws)}, reruns {len(rerun_seeds)}" if draws or rerun_seeds else ""
+    return float(train_s), float(rerun_s), drawn, draw_reruns, note
+
+
 def run_costs(run: Run, seeds: Sequence[int], other_top_seeds: int,
               episodes: tuple[float, float] = (np.nan, np.nan)) -> RunCosts:
     """The run's measured cost of a seed, from its Snakemake benchmark files (:meth:`efish.layout.Run.benchmark`):
     the mean CPU time of the ``seeds``' training and selection jobs, and of everything the top seeds' reruns ran
     (every file in a folder of its own under the top seeds' benchmarks, however the workflow grouped them) over
-    ``other_top_seeds``; ``episodes``: the selected seed's and the reruns' episodes per condition
+    ``other_top_seeds``, but their reruns with a draw of the homing recipes, which price a draw with those draws'
+    trainings (:func:`_draw_costs`); ``episodes``: the selected seed's and the reruns' episodes per condition
     (:class:`RunCosts`). A run without training benchmarks gets NaN costs (its designs are planned, not priced)."""
     train = [p for s in seeds if (p := run.benchmark(training_folder(seed_name(s)))).exists()]
     if not train:  # a run whose training is another's (a sweep's point that copies it) or was not run by Snakemake
@@ -148,11 +217,15 @@ def run_costs(run: Run, seeds: Sequence[int], other_top_seeds: int,
     selection = [p for s in seeds if (p := run.benchmark(str(Path(selection_table(s, "x")).parent))).exists()]
     top_seeds = run.benchmarks / Path(top_seed_copy(0)).parent  # each seed's or group's jobs in a folder of its own
     reruns = list(top_seeds.glob("*/**/*.tsv")) if top_seeds.is_dir() else []
-    rerun_s = sum(map(_cpu_seconds, reruns)) / other_top_seeds if other_top_seeds and reruns else 0.0
+    draw_train_s, draw_rerun_s, drawn, draw_reruns, draw_note = _draw_costs(run, reruns)
+    foraging = [p for p in reruns if p not in draw_reruns]
+    rerun_s = sum(map(_cpu_seconds, foraging)) / other_top_seeds if other_top_seeds and foraging else 0.0
+    groups = top_seeds / Path(top_seed_group("x")).parent.name
     return RunCosts(float(np.mean([_cpu_seconds(p) for p in train])),
                     float(np.mean([_cpu_seconds(p) for p in selection])) if selection else 0.0, float(rerun_s),
-                    f"training {len(train)}, selection {len(selection)}, reruns of {other_top_seeds} seeds",
-                    float(sum(map(_cpu_seconds, run.benchmarks.rglob("*.tsv")))), *episodes)
+                    f"training {len(train)}, selection {len(selection)}, reruns of {other_top_seeds} seeds"
+                    + draw_note, float(sum(map(_cpu_seconds, run.benchmarks.rglob("*.tsv")))), *episodes,
+                    draw_train_s, draw_rerun_s, drawn, tuple(sorted(p.stem for p in groups.glob("*.tsv"))))
 
 
 def own_test(methods: Sequence[str]) -> OwnTest | None:
@@ -300,7 +373,7 @@ def _plan_own(model: PartModel, alpha: float, costs: RunCosts) -> dict:
         n = units_needed(theta, own.sigma, own.test, model.sign, own.delta, alpha, verdict, own.family)
         episodes = None if n is None else int(np.ceil(n * per_unit - 1e-9))
         out[f"own_episodes_{key}"] = np.nan if episodes is None else episodes
-        out[f"own_cpu_hours_{key}"] = costs.episode_hours(episodes)
+        out[f"own_cpu_hours_{key}"] = costs.episode_hours(episodes, model.claim)
     return out
 
 
@@ -308,7 +381,8 @@ def plan_part(model: PartModel, alpha: float, costs: RunCosts) -> dict:
     """One row of :data:`PLAN_COLUMNS` for one part."""
     out = dict.fromkeys(PLAN_COLUMNS, np.nan) | {"claim": model.claim, "part": model.part,
                                                  "sign": np.nan if model.sign is None else float(model.sign),
-                                                 "delta": model.delta, "seeds": model.seeds, "note": model.note}
+                                                 "delta": model.delta, "seeds": model.seeds, "note": model.note,
+                                                 "draws": costs.draws(model.claim)}
     out |= _plan_own(model, alpha, costs)
     if model.own is None and model.own_note:
         out["note"] = "; ".join(n for n in (model.note, f"selected seed: {model.own_note}") if n)
@@ -330,14 +404,14 @@ def plan_part(model: PartModel, alpha: float, costs: RunCosts) -> dict:
         k = seeds_needed(comp, model.sign, model.planned_delta, alpha, theta, verdict, model.family)
         out[f"now_{key}"] = now[verdict]
         out[f"seeds_{key}"] = np.nan if k is None else k
-        out[f"cpu_hours_{key}"] = costs.design_hours(k)
+        out[f"cpu_hours_{key}"] = costs.design_hours(k, claim=model.claim)
         if k is None:
             notes.append(f"{name}: not within {MAX_SEEDS} seeds")
         if key == SCENARIO_KEYS[0]:  # the same question with more episodes per seed
             more = seeds_needed(comp, model.sign, model.planned_delta, alpha, theta, verdict, model.family,
                                 units=MORE_EPISODES * comp.units)
             out[f"seeds_{key}_more_episodes"] = np.nan if more is None else more
-            out[f"cpu_hours_{key}_more_episodes"] = costs.design_hours(more, MORE_EPISODES)
+            out[f"cpu_hours_{key}_more_episodes"] = costs.design_hours(more, MORE_EPISODES, model.claim)
     return out | {"note": "; ".join(notes)}
 
 
@@ -370,7 +444,7 @@ def power_curves(models: Sequence[PartModel], alpha: float, costs: RunCosts,
     for m in filter(_plannable, models):
         sd = m.comp.seed_sd()
         for k in seeds:
-            row = {"claim": m.claim, "part": m.part, "seeds": k, "cpu_hours": costs.design_hours(k)}
+            row = {"claim": m.claim, "part": m.part, "seeds": k, "cpu_hours": costs.design_hours(k, claim=m.claim)}
             for (_, multiple, sought), key in zip(SCENARIOS, SCENARIO_KEYS, strict=True):
                 row[key] = decision_probabilities(m.theta(multiple), sd, k, m.sign, m.planned_delta, alpha,
                                                   m.family)[scenario_verdict(m.sign, sought)]

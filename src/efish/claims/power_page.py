@@ -42,6 +42,11 @@ def power_markdown(plan: pd.DataFrame, costs: RunCosts, header: str, alpha: floa
              f"selection {costs.selection_s / 3600:.3g} h, reruns of the claims' assays {costs.rerun_s / 3600:.3g} h "
              f"(means over {costs.seeds_timed}; Snakemake's benchmark files of this run's jobs)."
              if np.isfinite(seed_h) else f"The designs are not priced: {costs.seeds_timed}.")
+    draw_h = (costs.draw_train_s + costs.draw_rerun_s) / 3600
+    if np.isfinite(seed_h) and np.isfinite(draw_h):
+        price += (f" One more draw of the homing recipes, which the homing claims are decided over, costs "
+                  f"{draw_h:.3g} CPU-hours: training them {costs.draw_train_s / 3600:.3g} h, a rerun of "
+                  f"{', '.join(costs.drawn_assays)} with them {costs.draw_rerun_s / 3600:.3g} h.")
     if np.isfinite(seed_h) and costs.run_s > 0:
         price += f" The whole run cost {costs.run_s / 3600:.3g} CPU-hours."
     planned = plan["tau"].notna() & plan["now_holds_at_2delta"].notna()
@@ -97,11 +102,12 @@ def _decider(plan_rows: pd.DataFrame, costs: RunCosts) -> tuple[float, float, fl
         return np.nan, np.nan, np.nan, (f"no design of up to {MAX_SEEDS:,} seeds settles {which}, even at twice "
                                         "delta: the spread between seeds dwarfs delta")
     seeds = int(k.max())
-    hours = costs.design_hours(seeds)
+    hours = float(plan_rows["cpu_hours_holds_at_2delta"].iloc[int(np.argmax(k.to_numpy()))])  # seeds or draws
     runs = hours * 3600 / costs.run_s if np.isfinite(hours) and costs.run_s > 0 else np.nan
     priced = (f" ({hours:.3g} CPU-hours here" + (f", {runs:.2g}x this run" if np.isfinite(runs) else "") + ")"
               if np.isfinite(hours) else "")
-    return seeds, hours, runs, f"about {seeds} seeds{priced} would settle {parts} if each effect were twice its delta"
+    unit = "draws of the homing recipes" if plan_rows["draws"].astype(bool).all() else "seeds"
+    return seeds, hours, runs, f"about {seeds} {unit}{priced} would settle {parts} if each effect were twice its delta"
 
 
 def claim_summary(plan: pd.DataFrame, claims: pd.DataFrame, recipe: pd.DataFrame, costs: RunCosts) -> pd.DataFrame:
@@ -149,6 +155,6 @@ def headline(plan: pd.DataFrame, costs: RunCosts) -> str:
     reach = f"{int(k.notna().sum())} of {plannable} plannable parts reach it"
     most = ""
     if k.notna().any():
-        hours = costs.design_hours(int(np.nanmax(k)))
+        hours = float(plan["cpu_hours_holds_at_2delta"].iloc[int(np.nanargmax(k.to_numpy(np.float64)))])
         most = f" with {int(np.nanmax(k))} seeds" + (f" ({hours:.3g} CPU-hours)" if np.isfinite(hours) else "")
     return f"{now} of {len(plan)} parts reach {TARGET:.0%} with this run's seeds if the effect is twice delta; {reach}{most}"

@@ -6,7 +6,9 @@ Two axes, one per planner scenario (:data:`efish.claims.power.SCENARIOS`): left,
 part's true effect is twice its delta; right, of "absent" (for a "no difference" part, "holds") if there is no
 effect. One line per claim: its weakest part's chance at each design (:func:`efish.claims.planner.claim_curves`,
 an upper bound on the claim's), a ring at the run's own number of seeds, a dashed line at the target. Claims none of
-whose parts can be planned are named in a note instead of drawn.
+whose parts can be planned are named in a note instead of drawn. A homing claim's seeds are draws of the homing
+recipes, priced as such (:meth:`efish.claims.planner.RunCosts.design_hours`): the top axis counts a foraging
+claim's seeds.
 
 Reads the tables of :mod:`efish.claims.planner`; no simulator, no torch.
 """
@@ -44,6 +46,7 @@ def plot_power(curves: pd.DataFrame, plan: pd.DataFrame, stem: Path, title: str)
     claims = list(dict.fromkeys(plan["claim"]))
     drawn = list(dict.fromkeys(by_claim["claim"])) if len(by_claim) else []
     now = plan.groupby("claim", sort=False)["seeds"].max()
+    draw_claims = set(plan.loc[plan["draws"].fillna(False).astype(bool), "claim"]) if "draws" in plan else set()
     priced = bool(len(by_claim)) and bool(np.isfinite(by_claim["cpu_hours"]).all())
     x = "cpu_hours" if priced else "seeds"
     with panel_style() as plt:
@@ -64,10 +67,13 @@ def plot_power(curves: pd.DataFrame, plan: pd.DataFrame, stem: Path, title: str)
             ax.set_xscale("log")
             _plain_log_ticks(ax.xaxis)
             if priced:  # a design's CPU-hours are its seeds times one seed's: the top axis counts the seeds
-                per_seed = float(by_claim["cpu_hours"].iloc[0] / by_claim["seeds"].iloc[0])
+                foraging = by_claim[~by_claim["claim"].isin(draw_claims)]
+                rows = foraging if len(foraging) else by_claim
+                per_seed = float(rows["cpu_hours"].iloc[0] / rows["seeds"].iloc[0])
                 top = ax.secondary_xaxis("top", functions=(lambda h, c=per_seed: h / c,
                                                            lambda k, c=per_seed: k * c))
-                top.set_xlabel("seeds", fontsize=FONT)
+                top.set_xlabel("seeds of a foraging claim (the homing claims' draws priced apart)"
+                               if draw_claims & set(drawn) and len(foraging) else "seeds", fontsize=FONT)
                 _plain_log_ticks(top.xaxis)
                 top.tick_params(labelsize=FONT - 1)
             ax.set_ylim(0, 1.02)
