@@ -3,7 +3,7 @@
 The ground floor of the simulator: it knows bodies, fields and sensors, never a
 task. Modules, from the formulas up:
 
-- ``fields``: closed-form monopole and dipole fields (SI units, softened).
+- ``fields``: closed-form monopole and dipole fields (SI units, softened); polarisability, induced dipoles.
 - ``images``: first- and higher-order wall images of sources (insulating walls).
 - ``geometry``: where the receptors sit on the body (angles, positions, normals).
 - ``snapshot``: :class:`Snapshot` (one arena, validated) and :class:`SnapshotBatch` (B arenas, the kernels' input).

@@ -11,6 +11,9 @@ sum K sources at M points (the reference and the scenes), while
 of each source at its own point, broadcast over any leading axes and not summed
 (the rollout's measures, which pair bodies with agents across a batch). Both
 shapes share the per-source terms below, so they cannot drift apart.
+
+Beside them, the step from a field to the sources it makes: :func:`polarisability`
+and :func:`induced_dipole`, the dipole an EOD field induces in a body.
 """
 
 from __future__ import annotations
@@ -40,6 +43,36 @@ def polarisability(radius_m: float | np.ndarray, susceptibility: float, eps0: fl
     -5.5631e-17
     """
     return radius_m ** 3 * susceptibility / coulomb_constant(eps0)
+
+
+def induced_dipole(alpha: float | np.ndarray, e_eod: np.ndarray, own: int | None = None) -> np.ndarray:
+    """Dipole p = alpha E (C*m, [..., 2]) that one emitter's EOD field E = ``e_eod`` (V/m, [..., 2], at the
+    bodies' centres) induces in bodies of polarisability ``alpha`` (C*m per V/m, :func:`polarisability`; a
+    scalar or [...], broadcast against the field's leading axes); ``own``, an index along axis -2 of the
+    result, is the emitter's own body, which gets none.
+
+    The induction step of the model (docs/model/physics.md#induction), the one place it is written: the
+    brute-force oracle (:mod:`efish.physics.reference`), the scenes and the rollout's recorded fields call
+    it; the numba kernels (:func:`efish.physics.kernels.induced_dipoles`,
+    :func:`efish.rollout.measure_kernels.field_sums`) repeat its product inside their loops over sources and
+    are tested against it. Why it is this simple: a body is small beside its distance to the EOD, so the field
+    is uniform over it and polarises it into a point dipole at its centre, parallel to the field; bodies are
+    insulators in water (chi < 0, so alpha < 0), which turns that dipole against the field. Its field is the
+    distortion of the EOD the Mormyromasts read. Only EODs induce, so ``e_eod`` is the field of
+    one emitter's monopoles, with their wall images or in free space as the caller's model has it;
+    induction is linear, so a body's dipole is the sum of these parts over the emitters, which callers keep
+    apart (self and cons) or add up. An emitter's own EOD does not polarise its own body (the model's rule:
+    the body is the sensor, and does not read its own polarisation; docs/model/differences.md).
+
+    >>> p = induced_dipole([-2.0, -1.0], np.array([[3.0, 0.0], [0.5, 4.0]]), own=0)
+    >>> print(p)  # body 0 emits: nothing induced in it; body 1 takes -1 x its field
+    [[ 0.   0. ]
+     [-0.5 -4. ]]
+    """
+    p = np.asarray(alpha, dtype=np.float64)[..., None] * np.asarray(e_eod, dtype=np.float64)
+    if own is not None:
+        p[..., own, :] = 0.0  # set after the product, so it is +0.0 whatever alpha's sign
+    return p
 
 
 def _as_points(name: str, a: np.ndarray, width: int = 2) -> np.ndarray:

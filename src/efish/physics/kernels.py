@@ -77,7 +77,9 @@ def image_table(width, height, idx, weights, c):
 @njit(cache=True, fastmath=_FASTMATH, error_model="numpy")
 def induced_dipoles(axy, heading, emitting, bx, by, alpha, img, c, p_ind):
     """p_ind[e, 0/1, body] = alpha_body * E_e(body) for every emitter e, own EOD excluded
-    (docs/model/physics.md#induction).
+    (docs/model/physics.md#induction). The step is :func:`efish.physics.fields.induced_dipole`'s, written
+    out here because a kernel cannot call that numpy function: the field is summed straight into ``p_ind``, in
+    the working dtype, and multiplied by alpha in place. tests/physics/test_induction.py holds the two equal.
 
     E_e is the field of e's two monopoles and all their wall images. Bodies are
     the innermost, contiguous loop so the sums vectorise; silent agents' rows are zero.
@@ -106,7 +108,7 @@ def induced_dipoles(axy, heading, emitting, bx, by, alpha, img, c, p_ind):
                     f = kqw * inv_r2 * np.sqrt(inv_r2)
                     px[j] += f * dx
                     py[j] += f * dy
-        for j in range(bx.shape[0]):
+        for j in range(bx.shape[0]):  # p = alpha E, as efish.physics.fields.induced_dipole
             px[j] *= alpha[j]
             py[j] *= alpha[j]
         px[e] = c[ZERO]  # a body is not polarised by its own EOD

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..units import CM
-from .fields import dipole_field, monopole_field
+from .fields import dipole_field, induced_dipole, monopole_field
 from .geometry import conspecific_slots, sensor_frame
 from .images import image_sources
 from .plan import EffectPlan
@@ -73,8 +73,7 @@ def _reference_env(batch: SnapshotBatch, b: int, plan: EffectPlan, out: RawReadi
             pos, q = eod_monopoles(xy[e], heading[e], plan)
             ipos, _, wq = image_sources(pos, None, w, h, idx, scale)
             e_at = monopole_field(bodies, ipos, np.tile(q, len(idx)) * wq, softening=soft, eps0=eps0)
-            p_ind[:, e] = alpha[:, None] * e_at
-            p_ind[e, e] = 0.0                                   # a body is not polarised by its own EOD
+            p_ind[:, e] = induced_dipole(alpha, e_at, own=e)
 
     p_int = intrinsic_moments(heading, phi, plan)
 

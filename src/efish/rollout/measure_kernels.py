@@ -183,7 +183,9 @@ def field_sums(src, lo, hi, cx, cy, ux, uy, kq, soft2):
     of the bodies ``lo:hi`` of ``src`` (see :func:`live_bodies`): sums (ax, ay, mx, my).
 
     Loops over bodies innermost without a branch, so the sums vectorise (hence fastmath's reassociation, as in
-    efish.physics.kernels); the rows are sliced first so the loop index starts at 0.
+    efish.physics.kernels); the rows are sliced first so the loop index starts at 0. The induced moment, alpha
+    times the agent's EOD field at the body, is :func:`efish.physics.fields.induced_dipole`'s step written out
+    per body, since a kernel cannot call that numpy function; tests/physics/test_induction.py holds the two equal.
     """
     x, y, px, py, alpha = src[0, lo:hi], src[1, lo:hi], src[2, lo:hi], src[3, lo:hi], src[4, lo:hi]
     ax = ay = mx = my = 0.0

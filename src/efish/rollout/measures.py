@@ -28,7 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..env.vec_env import VecEnv
-from ..physics.fields import coulomb_constant, pairwise_dipole_field, pairwise_monopole_field
+from ..physics.fields import coulomb_constant, induced_dipole, pairwise_dipole_field, pairwise_monopole_field
 from ..physics.plan import EffectPlan
 from ..physics.reference import eod_monopoles, intrinsic_moments
 from ..senses import SENSES, error_column
@@ -153,7 +153,7 @@ def homing_errors(env: VecEnv) -> dict[str, np.ndarray]:
     e_knollen = eod_field(plan, soft, txy, th, xy)
     p_intrinsic = intrinsic_moments(th, np.empty((len(th), 0)), plan)  # the target's own dipole [B, 1, 2]; no pellets
     e_amp = pairwise_dipole_field(xy, txy, p_intrinsic, **field)
-    p_induced = plan.alpha_agent * eod_field(plan, soft, xy, h, txy)   # each homer's EOD at the target
+    p_induced = induced_dipole(plan.alpha_agent, eod_field(plan, soft, xy, h, txy))  # in the target, per homer
     e_morm = pairwise_dipole_field(xy, txy, p_induced, **field)
     out = {}
     for sense, e in zip(SENSES, (e_morm, e_amp, e_knollen), strict=True):

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..env.geometry import nearest_pellet
 from ..env.vec_env import VecEnv
-from ..physics.fields import pairwise_dipole_field
+from ..physics.fields import induced_dipole, pairwise_dipole_field
 from ..physics.reference import intrinsic_moments
 from ..units import CM, wrap
 from .measures import SECTORS, eod_field
@@ -87,7 +87,7 @@ def log_fields_reference(env: VecEnv) -> dict[str, np.ndarray]:
     field = {"softening": soft, "eps0": plan.eps0}
     e_amp = pairwise_dipole_field(centre, bodies[:, None], p_int[:, None], **field)    # [B, N, N + P, 2]
     e_eod = eod_field(plan, soft, xy[:, :, None, :], h[:, :, None], bodies[:, None])   # own EOD at every body
-    e_morm = pairwise_dipole_field(centre, bodies[:, None], alpha[:, None] * e_eod, **field)
+    e_morm = pairwise_dipole_field(centre, bodies[:, None], induced_dipole(alpha, e_eod), **field)
     with np.errstate(divide="ignore"):
         return {name: np.log10(np.linalg.norm((e * others[..., None]).sum(2), axis=-1))
                 for name, e in (("log_amp_field", e_amp), ("log_morm_field", e_morm))}

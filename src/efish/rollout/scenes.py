@@ -31,7 +31,7 @@ from ..config import compose
 from ..config.compose import compose_variants
 from ..config.schema import EfishConfig, SceneConfig
 from ..env.arenas import sample_arena, sample_pellets
-from ..physics.fields import dipole_field, monopole_field
+from ..physics.fields import dipole_field, induced_dipole, monopole_field
 from ..physics.geometry import ampullary_angles, knollenorgan_angles, mormyromast_angles, sensor_frame
 from ..physics.images import image_sources
 from ..physics.plan import EffectPlan, Scene, build_plan
@@ -166,15 +166,15 @@ def emitter_charges(bodies: pd.DataFrame, plan: EffectPlan, arena_m: tuple[float
 
 
 def induced_moments(bodies: pd.DataFrame, emitters: list, plan: EffectPlan, eps0: float) -> np.ndarray:
-    """Dipole (K, 2) C*m induced on every body by the EODs (with images) of every emitter but itself
+    """Dipole (K, 2) C*m induced on every body by the EODs (with images) of every emitter but itself: the
+    physics' :func:`~efish.physics.fields.induced_dipole` of each emitter's field, summed
     (docs/model/physics.md#induction)."""
     xy = bodies[["x_cm", "y_cm"]].to_numpy() * CM
     alpha = np.where(bodies["element"].isin(["emitter", "agent"]), plan.alpha_agent, plan.alpha_pellet)
     moments = np.zeros((len(bodies), 2))
     for positions, charges, own in emitters:
         e = monopole_field(xy, positions, charges, softening=np.sqrt(plan.softening2), eps0=eps0)
-        e[own] = 0.0  # a body is not polarised by its own EOD
-        moments += alpha[:, None] * e
+        moments += induced_dipole(alpha, e, own=own)
     return moments
 
 
