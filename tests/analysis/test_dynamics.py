@@ -168,3 +168,22 @@ def test_plsc_episodes_gives_each_episodes_first_component_per_distance_bin():
     assert mid["s_1"].iloc[1] == pytest.approx(ref["singular_values"][0], rel=1e-12)
     alone = plsc_episodes(hidden, steps, agents=(0, 3))
     assert len(alone) == 1 and alone.loc[0, "reason"] == "agents 0 and 3 share no step"
+
+
+def test_d_eff_by_the_gram_matrix_is_the_svds_and_a_subsets_block_is_its_own():
+    """trace(G)^2 / ||G||_F^2 equals 1 / sum(lambda^2) of the SVD's normalised variances; a draw of units, read
+    from the whole Gram matrix's block, equals D_eff of those columns alone, degenerate draws included."""
+    rng = np.random.default_rng(3)
+    h = rng.normal(size=(500, 6)) @ rng.normal(size=(6, 12)) + 0.1 * rng.normal(size=(500, 12))
+    assert effective_dimensionality(h) == pytest.approx(1.0 / np.sum(pca_variances(h) ** 2), rel=1e-12)
+    h[:, 3] = 2.0  # a constant unit
+    h[7, 5] = np.nan  # a unit with a non-finite value
+    out = subsample_units(h, fractions=(0.05, 0.25, 0.5), draws=20, rng=4)
+    again = np.random.default_rng(4)
+    for _, row in out.iterrows():
+        k = row["n_units"]
+        sub = h[:, again.choice(h.shape[1], size=k, replace=False)]
+        assert row["reason"] == degenerate_reason(sub)
+        expected = effective_dimensionality(sub)
+        assert (np.isnan(row["d_eff"]) and np.isnan(expected)) or row["d_eff"] == pytest.approx(expected, rel=1e-12)
+    assert set(out["reason"]) >= {"", "non-finite values", "no unit varies"}
