@@ -21,7 +21,7 @@
                                               one episode of an assay as a clip, from its rollout tables
     efish contact-sheet [overrides] [--figures D] [--out F.png]   every panel's PNG as a thumbnail with its id
     efish gallery RUN [--figures D] [--results D] [--out D] [--max-width PX]   every panel of a run, web-sized,
-                                              with its caption on one page -> docs/gallery/index.md and img/
+                                              with its caption on one page -> figures/<run>/gallery/index.md and img/
     efish claims [overrides] [--results D] [--out D] [--ranking F] [--seed-claims SEED=F ...] [--trends F]
                                               the paper's claims as verdicts -> claims.parquet, claim_parts.parquet
                                               (one row per part), claims.md; with the other top seeds' claims
@@ -86,7 +86,7 @@ from ._version import __version__
 from .cli_claims import _sweep_runs, run_claims, run_claims_by_stage, run_compare_claims, run_power
 from .cli_support import HelpFormatter, add_command, add_overrides, run_at, run_of, see_docs, write_metadata
 from .config import ConfigError, compose, to_yaml
-from .figures.gallery import GALLERY, MAX_WIDTH_PX
+from .figures.gallery import GALLERY, MAX_WIDTH_PX, SITE_GALLERY
 from .layout import (
     ANALYSIS_SETTINGS,
     BENCH,
@@ -327,8 +327,8 @@ def _figure_commands(sub: argparse._SubParsersAction) -> None:
                                                  "(default figures/<run>)")
     ga.add_argument("--results", type=Path, help="the run's results folder: the commits of its tables' provenance "
                                                  "and the CPU of bench/bench_physics.json (default results/<run>)")
-    ga.add_argument("--out", type=Path, default=GALLERY, help=f"folder for index.md and the images under img/ "
-                                                              f"(default {GALLERY})")
+    ga.add_argument("--out", type=Path, help=f"folder for index.md and the images under img/ (default "
+                                             f"<figures>/{GALLERY}; the site's own page: --out {SITE_GALLERY})")
     ga.add_argument("--max-width", type=int, default=MAX_WIDTH_PX,
                     help=f"widest image in pixels: wider PNGs are scaled down (default {MAX_WIDTH_PX})")
     ga.set_defaults(handler=_gallery)  # no overrides: nothing to compose
@@ -791,11 +791,12 @@ def _gallery(args, cfg, started) -> None:
 
     # the page names the command that regenerates it: the run and the options that differ from their defaults
     given = {"--figures": (args.figures, FIGURES_ROOT / args.run), "--results": (args.results, RESULTS_ROOT / args.run),
-             "--out": (args.out, GALLERY), "--max-width": (args.max_width, MAX_WIDTH_PX)}
+             "--out": (args.out, None), "--max-width": (args.max_width, MAX_WIDTH_PX)}
     command = " ".join(["efish gallery", args.run, *(f"{flag} {value}" for flag, (value, default) in given.items()
                                                      if value is not None and value != default)])
-    drawn, absent = write_gallery(args.run, args.figures, args.results, args.out, args.max_width, command)
-    print(f"wrote {args.out / 'index.md'} and its images (panels drawn: {drawn}; not drawn in this run: {absent})")
+    out = args.out if args.out is not None else (args.figures or FIGURES_ROOT / args.run) / GALLERY
+    drawn, absent = write_gallery(args.run, args.figures, args.results, out, args.max_width, command)
+    print(f"wrote {out / 'index.md'} and its images (panels drawn: {drawn}; not drawn in this run: {absent})")
 
 
 def _plan_cluster(args, cfg, started) -> None:

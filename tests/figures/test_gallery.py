@@ -126,11 +126,18 @@ def test_a_missing_figure_folder_is_one_line(tmp_path, capsys):
     assert not (tmp_path / "g").exists()
 
 
+def test_by_default_a_runs_gallery_goes_under_its_figures_not_onto_the_sites_page(run, capsys):
+    assert main(["gallery", "fake", "--figures", str(run["figures"]), "--results", str(run["results"])]) == 0
+    page = run["figures"] / "gallery" / "index.md"
+    assert page.is_file() and str(page) in capsys.readouterr().out
+    assert f"efish gallery fake --figures {run['figures']} --results {run['results']}\n" in page.read_text()
+
+
 def test_the_committed_gallery_lists_every_panel_of_the_registry():
-    """Adding a panel without regenerating the gallery (efish gallery laptop) fails here."""
+    """Adding a panel without regenerating the gallery (efish gallery laptop --out docs/gallery) fails here."""
     page = (COMMITTED / "index.md").read_text()
     listed = set(entries(page.split(OTHERS, 1)[0]))
-    assert listed == set(PANELS), ("regenerate docs/gallery (efish gallery laptop): "
+    assert listed == set(PANELS), ("regenerate docs/gallery (efish gallery laptop --out docs/gallery): "
                                    f"missing {sorted(set(PANELS) - listed)}, no longer registered {sorted(listed - set(PANELS))}")
     linked = set(re.findall(r"\]\((img/[^)]+\.png)\)", page))
     on_disk = {str(p.relative_to(COMMITTED)) for p in (COMMITTED / "img").rglob("*.png")}

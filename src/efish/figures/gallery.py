@@ -29,7 +29,11 @@ from ..layout import BENCH, FIGURES_ROOT, RESULTS_ROOT
 if TYPE_CHECKING:  # the command line imports this module for its defaults: nothing heavy at import
     from .panel import Panel
 
-GALLERY = Path("docs/gallery")
+#: The site's gallery (docs/gallery/index.md), which the developers regenerate with ``--out docs/gallery``.
+SITE_GALLERY = Path("docs/gallery")
+#: The folder of a run's own gallery, under its figure folder: ``efish gallery``'s default, so that a user's run
+#: never overwrites the site's page.
+GALLERY = "gallery"
 PAGE = "index.md"
 IMAGES = "img"
 MAX_WIDTH_PX = 900
@@ -215,17 +219,18 @@ def _grid(entries: Iterable[list[str]]) -> list[str]:
     return ['<div class="efish-gallery" markdown>', "", *[line for e in entries for line in e], "</div>", ""]
 
 
-def write_gallery(run: str, figures: Path | None = None, results: Path | None = None, out: Path = GALLERY,
+def write_gallery(run: str, figures: Path | None = None, results: Path | None = None, out: Path | None = None,
                   max_width: int = MAX_WIDTH_PX, command: str | None = None) -> tuple[int, int]:
     """Write ``out/index.md`` and ``out/img/`` for the run ``run`` (its folders default to ``figures/<run>`` and
-    ``results/<run>``); images of an earlier gallery that this run does not draw are removed. ``command`` is the
-    line the page says regenerates it. Returns (registered panels drawn, registered panels not drawn)."""
+    ``results/<run>``, ``out`` to ``<figures>/gallery``); images of an earlier gallery that this run does not draw
+    are removed. ``command`` is the line the page says regenerates it. Returns (registered panels drawn, registered
+    panels not drawn)."""
     from .registry import PANELS
     from .registry import figures as by_figure
 
     figures = Path(figures) if figures is not None else FIGURES_ROOT / run
     results = Path(results) if results is not None else RESULTS_ROOT / run
-    out = Path(out)
+    out = Path(out) if out is not None else figures / GALLERY
     if not figures.is_dir():
         raise ValueError(f"no figure folder {figures}: draw the run's figures first, or pass --figures")
     if max_width < 16:
