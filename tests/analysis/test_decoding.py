@@ -22,6 +22,7 @@ from efish.analysis.decoding import (
     decoded_value,
     food_decode_episodes,
     heldout_skill,
+    heldout_skills,
     summarise,
 )
 from efish.analysis.registry import run
@@ -54,6 +55,27 @@ def test_a_planted_readout_has_skill_near_1_on_every_held_out_episode():
     angle = np.arctan2(x[:, 1], x[:, 0])  # a circular target; its cos and sin are not linear in x,
     circ = heldout_skill(np.c_[x, np.cos(angle), np.sin(angle)], angle, groups, circular=True)  # unless given
     assert circ["skill"].min() > 0.99
+
+
+def test_targets_decoded_together_get_each_the_readout_it_gets_alone():
+    """Targets sharing their finite rows share each fold's least-squares fit; every target's table is the one
+    heldout_skill gives it alone (to rounding), whatever the others: other NaN rows, circular, constant, too few
+    episodes."""
+    rng = np.random.default_rng(5)
+    x, groups = planted(rng)
+    gappy = x @ rng.normal(size=20)
+    gappy[rng.random(len(x)) < 0.2] = np.nan  # other finite rows: a fit of its own
+    targets = {"linear": (x @ rng.normal(size=20) + rng.normal(size=len(x)), False),
+               "angle": (np.arctan2(x[:, 1], x[:, 0]), True), "noise": (rng.normal(size=len(x)), False),
+               "gappy": (gappy, False), "constant": (np.full(len(x), 2.0), False),
+               "one episode": (np.where(groups == 3, 1.0, np.nan), False)}
+    together = heldout_skills(x, targets, groups)
+    assert list(together) == list(targets)
+    for name, (y, circular) in targets.items():
+        alone = heldout_skill(x, y, groups, circular)
+        pd.testing.assert_frame_equal(together[name], alone, rtol=1e-9, atol=1e-12, obj=name)
+    assert together["constant"]["reason"].item() == "constant target"
+    assert together["one episode"]["reason"].item().startswith("fewer than 2 groups")
 
 
 def test_noise_has_no_skill_and_an_episode_constant_leaks_only_when_episodes_are_split():

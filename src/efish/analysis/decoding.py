@@ -97,39 +97,72 @@ def heldout_skill(x: np.ndarray, y: np.ndarray, groups: np.ndarray, circular: bo
     target: one row, group NaN, with the reason. A group whose target the
     training mean predicts exactly has no skill (NaN) and says so.
     """
+    return heldout_skills(x, {"y": (y, circular)}, groups, folds)["y"]
+
+
+def heldout_skills(x: np.ndarray, targets: dict[str, tuple[np.ndarray, bool]], groups: np.ndarray,
+                   folds: int = DEFAULTS.decode_folds) -> dict[str, pd.DataFrame]:
+    """:func:`heldout_skill` of several targets from the same ``x`` and ``groups``: name -> (values, circular) in,
+    name -> its table out, in the same order.
+
+    Targets whose finite rows are the same have the same folds, and OLS fits each output column on its own, so
+    they share each fold's fit: one least-squares solve with their columns side by side instead of one per target
+    (the decoding tables' twenty-odd targets, five folds each, were most of a dynamics job). Each target's
+    readout is the one it would get alone, to rounding.
+    """
     from sklearn.linear_model import LinearRegression
     from sklearn.model_selection import GroupKFold
 
     x = np.asarray(x, np.float64)
     x = x[:, None] if x.ndim == 1 else x
-    y, groups = np.asarray(y, np.float64), np.asarray(groups)
-    if not len(x) == len(y) == len(groups):
-        raise ValueError(f"x, y and groups differ in length: {len(x)}, {len(y)}, {len(groups)}")
-    target = np.column_stack([np.cos(y), np.sin(y)]) if circular else y[:, None]
-    keep = np.all(np.isfinite(x), axis=1) & np.all(np.isfinite(target), axis=1)
-    x, target, groups = x[keep], target[keep], groups[keep]
-    names = np.unique(groups)
-    n_folds = min(folds, len(names))
+    groups = np.asarray(groups)
+    tables: dict[str, pd.DataFrame] = {}
+    values: dict[str, np.ndarray] = {}
+    shared: dict[bytes, list[str]] = {}  # the targets of each set of finite rows
+    for name, (y, circular) in targets.items():
+        y = np.asarray(y, np.float64)
+        if not len(x) == len(y) == len(groups):
+            raise ValueError(f"x, y and groups differ in length: {len(x)}, {len(y)}, {len(groups)}")
+        target = np.column_stack([np.cos(y), np.sin(y)]) if circular else y[:, None]
+        keep = np.all(np.isfinite(x), axis=1) & np.all(np.isfinite(target), axis=1)
+        n_groups = len(np.unique(groups[keep]))
+        n_folds = min(folds, n_groups)
+        if n_groups < 2:
+            tables[name] = _undecodable(int(keep.sum()), n_folds,
+                                        f"fewer than 2 groups (episodes) with finite rows ({n_groups})")
+        elif not np.any(np.ptp(target[keep], axis=0) > 0):
+            tables[name] = _undecodable(int(keep.sum()), n_folds, "constant target")
+        else:
+            values[name] = target
+            shared.setdefault(keep.tobytes(), []).append(name)
+    for key, names in shared.items():
+        keep = np.frombuffer(key, dtype=bool)
+        xs, gs = x[keep], groups[keep]
+        n_folds = min(folds, len(np.unique(gs)))
+        columns = np.cumsum([0, *(values[n].shape[1] for n in names)])
+        both = np.hstack([values[n][keep] for n in names])
+        rows: dict[str, list[dict]] = {n: [] for n in names}
+        for train, test in GroupKFold(n_splits=n_folds).split(xs, both, gs):
+            fitted = LinearRegression().fit(xs[train], both[train]).predict(xs[test]).reshape(-1, both.shape[1])
+            for name, lo, hi in zip(names, columns[:-1], columns[1:], strict=True):
+                target = both[:, lo:hi]
+                err = ((fitted[:, lo:hi] - target[test]) ** 2).sum(axis=1)
+                base = ((target[train].mean(axis=0) - target[test]) ** 2).sum(axis=1)
+                for g in np.unique(gs[test]):
+                    mine = gs[test] == g
+                    sse, sse0 = err[mine].sum(), base[mine].sum()
+                    rows[name].append({"episode": g, "n": int(mine.sum()), "sse": sse, "sse_mean": sse0,
+                                       "skill": 1.0 - sse / sse0 if sse0 > 0 else np.nan, "folds": n_folds,
+                                       "reason": "" if sse0 > 0 else "the training mean predicts it exactly"})
+        for name in names:
+            tables[name] = pd.DataFrame(rows[name], columns=SKILL_COLUMNS).sort_values("episode", kind="stable",
+                                                                                       ignore_index=True)
+    return {name: tables[name] for name in targets}
 
-    def undecodable(reason: str) -> pd.DataFrame:
-        return pd.DataFrame([{"episode": np.nan, "n": int(keep.sum()), "folds": n_folds, "reason": reason}],
-                            columns=SKILL_COLUMNS)
-    if len(names) < 2:
-        return undecodable(f"fewer than 2 groups (episodes) with finite rows ({len(names)})")
-    if not np.any(np.ptp(target, axis=0) > 0):
-        return undecodable("constant target")
-    rows = []
-    for train, test in GroupKFold(n_splits=n_folds).split(x, target, groups):
-        pred = LinearRegression().fit(x[train], target[train]).predict(x[test]).reshape(-1, target.shape[1])
-        err = ((pred - target[test]) ** 2).sum(axis=1)
-        base = ((target[train].mean(axis=0) - target[test]) ** 2).sum(axis=1)
-        for g in np.unique(groups[test]):
-            mine = groups[test] == g
-            sse, sse0 = err[mine].sum(), base[mine].sum()
-            rows.append({"episode": g, "n": int(mine.sum()), "sse": sse, "sse_mean": sse0,
-                         "skill": 1.0 - sse / sse0 if sse0 > 0 else np.nan, "folds": n_folds,
-                         "reason": "" if sse0 > 0 else "the training mean predicts it exactly"})
-    return pd.DataFrame(rows, columns=SKILL_COLUMNS).sort_values("episode", kind="stable", ignore_index=True)
+
+def _undecodable(n: int, folds: int, reason: str) -> pd.DataFrame:
+    """The one row of a target that cannot be decoded: its finite rows, the folds it would have had, why."""
+    return pd.DataFrame([{"episode": np.nan, "n": n, "folds": folds, "reason": reason}], columns=SKILL_COLUMNS)
 
 
 def decoded_value(steps: pd.DataFrame, target: str) -> np.ndarray:
@@ -164,11 +197,13 @@ def decode_episodes(hidden: pd.DataFrame, steps: pd.DataFrame, targets: dict[str
     h, parts = units(hidden), []
     for cond, sub in joined.groupby("condition", sort=True):
         x, episodes = sub[h].to_numpy(np.float64), sub["episode"].to_numpy()
+        skills = heldout_skills(x, {t: (decoded_value(sub, t), c) for t, c in targets.items() if t in present},
+                                episodes, folds)
         for target, circular in targets.items():
-            skills = (heldout_skill(x, decoded_value(sub, target), episodes, circular, folds)
-                      if target in present else nan_frame(f"steps table lacks column {target!r}", episode=np.nan))
-            parts.append(skills.assign(condition=cond, target=target, circular=circular,
-                                       readout=target in READOUT_TARGETS))
+            found = skills[target] if target in present else nan_frame(f"steps table lacks column {target!r}",
+                                                                       episode=np.nan)
+            parts.append(found.assign(condition=cond, target=target, circular=circular,
+                                      readout=target in READOUT_TARGETS))
     if not parts:
         return nan_frame("no hidden row matches a step").reindex(columns=DECODED_COLUMNS)
     return pd.concat(parts, ignore_index=True).reindex(columns=DECODED_COLUMNS)
