@@ -787,14 +787,14 @@ def _contact_sheet(args, cfg, started) -> None:
 
 
 def _gallery(args, cfg, started) -> None:
-    from .figures.gallery import write_gallery
+    from .figures.gallery import gallery_folder, write_gallery
 
     # the page names the command that regenerates it: the run and the options that differ from their defaults
     given = {"--figures": (args.figures, FIGURES_ROOT / args.run), "--results": (args.results, RESULTS_ROOT / args.run),
              "--out": (args.out, None), "--max-width": (args.max_width, MAX_WIDTH_PX)}
     command = " ".join(["efish gallery", args.run, *(f"{flag} {value}" for flag, (value, default) in given.items()
                                                      if value is not None and value != default)])
-    out = args.out if args.out is not None else (args.figures or FIGURES_ROOT / args.run) / GALLERY
+    out = gallery_folder(args.run, args.figures, args.out)
     drawn, absent = write_gallery(args.run, args.figures, args.results, out, args.max_width, command)
     print(f"wrote {out / 'index.md'} and its images (panels drawn: {drawn}; not drawn in this run: {absent})")
 

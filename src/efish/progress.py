@@ -165,10 +165,10 @@ def pipeline_watch(run: Run, workdir: Path = Path(".")) -> PipelineWatch | None:
     """The pipeline line's watch of ``run`` when it can have one: a run of a shipped scale (config/scale/) in the
     ``results/`` folder of the workflow in ``workdir``; else None (a run elsewhere, or with overrides, whose
     Snakemake call the watch cannot know)."""
-    from .config import config_dir
     from .layout import RESULTS_ROOT
+    from .watch import is_shipped_scale
 
-    if not (workdir / "Snakefile").is_file() or not (config_dir() / "scale" / f"{run.name}.yaml").is_file():
+    if not (workdir / "Snakefile").is_file() or not is_shipped_scale(run.name):
         return None
     if Path(run.results).resolve() != (workdir / RESULTS_ROOT / run.name).resolve():
         return None
@@ -197,8 +197,8 @@ class PipelineWatch:
     def line(self, now: float | None = None) -> str:
         """The progress line, or why there is none (a dry run that failed)."""
         now = time.monotonic() if now is None else now
+        finished = finished_jobs(self.run, self.workdir)  # once a call: a thousand small files at the laptop scale
         if now - self._planned_at >= self.every:
-            finished = finished_jobs(self.run, self.workdir)
             try:
                 self._planned = jobs_to_run(self.run.name, self.workdir)
                 self._error = None
@@ -208,5 +208,5 @@ class PipelineWatch:
         if self._error:
             self.last = None
             return f"pipeline: {self._error}"
-        self.last = progress(finished_jobs(self.run, self.workdir), self._planned, self._finished_then)
+        self.last = progress(finished, self._planned, self._finished_then)
         return self.last.line()

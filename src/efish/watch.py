@@ -72,7 +72,7 @@ def planned_updates(run_name: str) -> dict[str, int | None]:
     """Job folder -> updates, of every job a shipped scale trains: its seeds and the policy recipes its assays act
     with (the run plan's training targets); {} for another run (its overrides, which may change both, are not
     recorded in its name)."""
-    if not _is_shipped_scale(run_name):
+    if not is_shipped_scale(run_name):
         return {}
     from .run_plan import RunPlan  # the plan composes every assay: only for a shipped scale
 
@@ -87,12 +87,13 @@ def _recipe_updates(run_name: str, name: str) -> int | None:
     """The updates of a policy recipe's job (or of a later draw of it, ``homing_draw_2``: the same training with
     another seed) under a shipped scale, else None."""
     recipe = parse_recipe_draw(name)[0]
-    if not _is_shipped_scale(run_name) or not (config_dir() / "policy" / f"{recipe}.yaml").is_file():
+    if not is_shipped_scale(run_name) or not (config_dir() / "policy" / f"{recipe}.yaml").is_file():
         return None
     return compose([f"scale={run_name}", f"policy={recipe}"]).train.total_updates()
 
 
-def _is_shipped_scale(run_name: str) -> bool:
+def is_shipped_scale(run_name: str) -> bool:
+    """Whether a run's folder name is a scale of config/scale/ as shipped (no overrides): its plan is known."""
     return (config_dir() / "scale" / f"{run_name}.yaml").is_file()
 
 

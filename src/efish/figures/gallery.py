@@ -219,6 +219,11 @@ def _grid(entries: Iterable[list[str]]) -> list[str]:
     return ['<div class="efish-gallery" markdown>', "", *[line for e in entries for line in e], "</div>", ""]
 
 
+def gallery_folder(run: str, figures: Path | None = None, out: Path | None = None) -> Path:
+    """Where a run's gallery goes: ``out``, else ``<figures>/gallery`` (``figures`` defaulting to ``figures/<run>``)."""
+    return Path(out) if out is not None else (Path(figures) if figures is not None else FIGURES_ROOT / run) / GALLERY
+
+
 def write_gallery(run: str, figures: Path | None = None, results: Path | None = None, out: Path | None = None,
                   max_width: int = MAX_WIDTH_PX, command: str | None = None) -> tuple[int, int]:
     """Write ``out/index.md`` and ``out/img/`` for the run ``run`` (its folders default to ``figures/<run>`` and
@@ -230,7 +235,7 @@ def write_gallery(run: str, figures: Path | None = None, results: Path | None = 
 
     figures = Path(figures) if figures is not None else FIGURES_ROOT / run
     results = Path(results) if results is not None else RESULTS_ROOT / run
-    out = Path(out) if out is not None else figures / GALLERY
+    out = gallery_folder(run, figures, out)
     if not figures.is_dir():
         raise ValueError(f"no figure folder {figures}: draw the run's figures first, or pass --figures")
     if max_width < 16:
