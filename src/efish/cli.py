@@ -760,13 +760,14 @@ def _figure(args, cfg, started) -> None:
 
 
 def _render(args, cfg, started) -> None:
-    from .figures.episode import clip_writer, load_episode, render_clip
+    from .figures.clip_file import clip_encoder
+    from .figures.episode import load_episode, render_clip
 
     # assay= picks the tables, not the run: the default folders are the run's (results/smoke for scale=smoke)
     run = run_of(cfg, [o for o in args.overrides if not o.startswith("assay=")])
     tables = args.tables or run.path(assay_folder(cfg.assay.name))
     out = args.out or run.clip(cfg.assay.name)
-    clip_writer(out)  # a wrong suffix, or .mp4 without ffmpeg, fails before any table is read
+    clip_encoder(out)  # a wrong suffix, or .mp4 without ffmpeg, fails before any table is read
     episode = load_episode(tables, args.overrides, cfg, args.condition, args.episode)
     frames = render_clip(episode, out, every=args.every, fps=args.fps, field=args.field,
                          progress=lambda rows: _progress(rows, "frames", unit="frame", every=max(1, len(rows) // 10)))

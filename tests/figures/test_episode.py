@@ -4,6 +4,8 @@ checked artist by artist."""
 from __future__ import annotations
 
 import math
+import shutil
+import subprocess
 
 import numpy as np
 import pandas as pd
@@ -13,8 +15,10 @@ from tests.helpers import rollout_tables
 
 from efish.cli import main
 from efish.config import compose
+from efish.figures import clip_file as clip_file_module
 from efish.figures import episode as episode_module
-from efish.figures.episode import FieldOverlay, clip_writer, draw_frame, frame_rows, load_episode, render_clip, spans
+from efish.figures.clip_file import BlitFrames, clip_encoder
+from efish.figures.episode import FieldOverlay, draw_frame, frame_rows, load_episode, render_clip, spans
 from efish.figures.style import panel_style
 from efish.rollout.tables import write_tables
 
@@ -122,6 +126,43 @@ def test_the_gif_has_one_frame_per_drawn_step(ep, tmp_path):
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # written atomically, no leftovers
 
 
+@pytest.mark.parametrize("t", [0, 12, 20])
+def test_a_blitted_frame_is_the_full_draw_of_the_same_frame(ep, t):
+    """The background saved without the walls and the clock, the frame's artists and those drawn over it in
+    z-order: the same pixels as matplotlib's full draw (with the field overlay, which sits under the walls)."""
+    from efish.drawing import FRAME_DPI, frame_size
+
+    overlay = FieldOverlay(ep)
+    with panel_style() as plt:
+        fig = plt.figure(figsize=frame_size(70.0, 70.0, True), dpi=FRAME_DPI, layout="constrained")
+        ax = fig.add_subplot()
+        clock = episode_module.draw_arena(fig, ax, ep, overlay)
+        fig.canvas.draw()
+        fig.set_layout_engine("none")
+        frames = BlitFrames(fig, ax, moving=[clock])
+        artists = [a for group in draw_frame(ax, ep, row_of(ep, t), overlay).values() for a in group]
+        clock.set_text(f"frame of step {t}")
+        blitted = frames.grab(artists)
+        fig.canvas.draw()
+        full = np.asarray(fig.canvas.buffer_rgba()).copy()
+        plt.close(fig)
+    assert blitted.shape == full.shape
+    differ = (blitted != full).any(axis=2)
+    assert not differ.any(), f"{differ.sum()} of {differ.size} pixels differ"
+
+
+@pytest.mark.skipif(shutil.which("ffmpeg") is None, reason="needs ffmpeg on PATH (.ci/run installs it)")
+def test_the_mp4_has_one_frame_per_drawn_step(ep, tmp_path):
+    out = tmp_path / "clip.mp4"
+    assert render_clip(ep, out, every=3) == 11  # steps 0, 3, ..., 27 and the last, 29
+    probe = subprocess.run(["ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0", "-show_entries",
+                            "stream=nb_read_frames,width,height", "-of", "csv=p=0", str(out)],
+                           capture_output=True, text=True, check=True)
+    width, height, frames = (int(v) for v in probe.stdout.strip().split(","))
+    assert frames == 11 and width % 2 == 0 and height % 2 == 0
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]
+
+
 def test_the_default_stride_keeps_a_gif_in_real_time_and_short(ep, monkeypatch):
     assert ep.fps / 2 <= episode_module.GIF_MAX_FPS < ep.fps  # 83 fps: every second step
     assert list(frame_rows(ep, None, ".gif")) == [*range(0, STEPS, 2), STEPS - 1]
@@ -188,12 +229,12 @@ def test_the_defaults_are_the_first_condition_and_episode(tables, cfg):
 
 
 def test_clip_files_are_gif_or_mp4_with_ffmpeg(monkeypatch, tmp_path):
-    assert clip_writer(tmp_path / "a.GIF") == "pillow"
+    assert clip_encoder(tmp_path / "a.GIF") == "pillow"
     with pytest.raises(ValueError, match="must end in .gif or .mp4"):
-        clip_writer(tmp_path / "a.avi")
-    monkeypatch.setattr(episode_module.shutil, "which", lambda name: None)
+        clip_encoder(tmp_path / "a.avi")
+    monkeypatch.setattr(clip_file_module.shutil, "which", lambda name: None)
     with pytest.raises(ValueError, match="needs ffmpeg on PATH"):
-        clip_writer(tmp_path / "a.mp4")
+        clip_encoder(tmp_path / "a.mp4")
 
 
 def test_spans_compacts_episode_lists():

@@ -15,7 +15,6 @@ tests (and the clip writer) can count and remove them.
 from __future__ import annotations
 
 import math
-import shutil
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -28,6 +27,7 @@ from ..config.schema import EfishConfig
 from ..drawing import BODY_PT, FRAME_DPI, body_marker, draw_bodies, draw_pellets, draw_walls, frame_size
 from ..io import atomic_path, read_parquet
 from ..units import CM
+from .clip_file import BlitFrames, clip_encoder, clip_file
 from .style import HEATMAP_CMAP, NEUTRAL_COLOUR, PELLET_COLOUR, agent_colour, panel_style
 
 #: GIF frame delays are whole centiseconds and browsers slow delays under 2 cs down, so a GIF plays at most
@@ -37,7 +37,6 @@ GIF_MAX_FPS = 50.0
 #: size is a few MB, small enough for the Snakemake report.
 MAX_FRAMES = 400
 FIELD_CELLS = 60  # cells of the field overlay along the arena's longer side
-WRITERS = {".gif": "pillow", ".mp4": "ffmpeg"}
 
 
 @dataclass(frozen=True)
@@ -308,46 +307,35 @@ def frame_rows(ep: Episode, every: int | None, suffix: str) -> np.ndarray:
     return np.unique(np.r_[np.arange(0, len(ep.t), every), len(ep.t) - 1])  # the last step too: how it ends
 
 
-def clip_writer(out: Path) -> str:
-    """The matplotlib writer for a clip file (Pillow for .gif, ffmpeg for .mp4); a clear error for another
-    suffix, or for .mp4 without ffmpeg on PATH. Cheap: callers check before loading any table."""
-    suffix = Path(out).suffix.lower()
-    if suffix not in WRITERS:
-        raise ValueError(f"cannot write a clip to {out}: the file must end in {' or '.join(WRITERS)}")
-    if suffix == ".mp4" and shutil.which("ffmpeg") is None:
-        raise ValueError("writing .mp4 needs ffmpeg on PATH, which is not there: write a .gif instead")
-    return WRITERS[suffix]
-
-
 def render_clip(ep: Episode, out: Path, every: int | None = None, fps: float | None = None, field: bool = False,
                 progress: Callable[[list], Iterable] | None = None) -> int:
     """Write ``ep`` as an animation to ``out`` (``.gif`` with Pillow, ``.mp4`` with ffmpeg), atomically;
     ``fps`` defaults to real time (env.fps over the stride). ``progress`` wraps the list of frames (a bar).
+    Each frame is drawn over the figure's saved background (:class:`~efish.figures.clip_file.BlitFrames`).
     Returns the number of frames."""
-    from matplotlib import animation
-
     out = Path(out)
-    suffix = out.suffix.lower()
-    writer_name = clip_writer(out)
-    rows = frame_rows(ep, every, suffix)
+    clip_encoder(out)
+    rows = frame_rows(ep, every, out.suffix.lower())
     fps = ep.fps * len(rows) / len(ep.t) if fps is None else float(fps)
     if not fps > 0:
         raise ValueError(f"--fps must be positive, got {fps}")
     overlay = FieldOverlay(ep) if field else None
     with panel_style() as plt:
         fig = plt.figure(figsize=frame_size(float(ep.cfg.arena.width_cm), float(ep.cfg.arena.height_cm), field),
-                         layout="constrained")
+                         dpi=FRAME_DPI, layout="constrained")
         ax = fig.add_subplot()
         clock = draw_arena(fig, ax, ep, overlay)
         fig.canvas.draw()
         fig.set_layout_engine("none")  # lay out once: the axes must not move between frames
-        writer = animation.writers[writer_name](fps=fps)
-        with atomic_path(out) as tmp, writer.saving(fig, str(tmp), dpi=FRAME_DPI):
+        frames = BlitFrames(fig, ax, moving=[clock])
+        with atomic_path(out) as tmp:
+            writer = clip_file(tmp, fps)
             for i in (progress(list(rows)) if progress else rows):
-                artists = draw_frame(ax, ep, int(i), overlay)
+                artists = [a for group in draw_frame(ax, ep, int(i), overlay).values() for a in group]
                 clock.set_text(_clock(ep, int(ep.t[i])))
-                writer.grab_frame()
-                for artist in (a for group in artists.values() for a in group):
+                writer.write(frames.grab(artists))
+                for artist in artists:
                     artist.remove()
+            writer.close()
         plt.close(fig)
     return len(rows)
