@@ -107,5 +107,38 @@ def test_search_finds_a_word_from_the_sites_files_in_a_real_browser(site):
     assert dom.count('class="md-search-result__item"') >= 1
 
 
+MATH_FONT = "TeX Gyre Termes Math"
+FONT_PROBE = """<!doctype html><html><head><link rel="stylesheet" href="../css/extra.css"></head><body>
+<div class="md-typeset"><math><mrow><mo>{</mo><mfrac><mi>a</mi><mi>b</mi></mfrac></mrow></math></div>
+<pre id="fonts">pending</pre><script>document.fonts.ready.then(() => {
+  document.getElementById("fonts").textContent = [...document.fonts].map(f => f.family + "=" + f.status).join(";");
+});</script></body></html>"""
+
+
+def test_the_equations_maths_font_ships_with_the_site(site):
+    """The stylesheet sets the maths font on every equation and its file (with its licence) is in the site."""
+    css = (site / "css" / "extra.css").read_text()
+    face = re.search(r'@font-face \{ font-family: "([^"]+)"; src: url\("([^"]+)"\)', css)
+    assert face and face.group(1) == MATH_FONT
+    assert (site / "css" / face.group(2)).resolve().is_file()
+    assert re.search(rf'\.md-typeset math \{{ font-family: "{MATH_FONT}"', css)
+    assert (site / "fonts" / "LICENSE-texgyretermes-math.txt").is_file()
+
+
+@pytest.mark.skipif(CHROMIUM is None, reason="no Chromium to open the site in (.ci/run installs Debian's chromium)")
+def test_a_real_browser_loads_the_maths_font_from_the_sites_files(site):
+    """Opened by file:// with no network, a page of the site that holds an equation loads the shipped font (a
+    browser's default fonts have no OpenType MATH table: braces would not stretch)."""
+    probe = site / "model" / "font-probe.html"
+    probe.write_text(FONT_PROBE)
+    try:
+        dom = subprocess.run([CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--virtual-time-budget=5000",
+                              "--dump-dom", probe.as_uri()], capture_output=True, text=True, timeout=120).stdout
+    finally:
+        probe.unlink()
+    fonts = re.search(r'id="fonts">([^<]*)<', dom)
+    assert fonts and f"{MATH_FONT}=loaded" in fonts.group(1).split(";"), fonts.group(1) if fonts else dom[-300:]
+
+
 def test_the_sites_build_code_is_not_in_the_site(site):
     assert not list(site.rglob("*.py"))
