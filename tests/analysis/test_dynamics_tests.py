@@ -18,30 +18,59 @@ from efish.analysis.dynamics_tests import (
     size_tests,
 )
 from efish.analysis.stats import STAT_COLUMNS
+from efish.config.recorded import recorded_conditions
+
+from ..helpers import conditions_of
 
 
-def test_groupsize_parts_parse_n_and_knollenorgans_and_drop_others():
-    parts = groupsize_parts(pd.DataFrame({"condition": ["n2_K", "n8_noK", "control", "n3_Kx"]}))
-    assert parts["n_agents"].tolist() == [2, 8] and parts["knollenorgans"].tolist() == ["K", "noK"]
+def groupsize_configs(**renamed: str):
+    """The groupsize assay's recorded conditions (N = 1-4, Knollenorgans on and off), conditions renamed as given."""
+    configs = recorded_conditions(conditions_of("groupsize"))
+    return {renamed.get(name, name): cfg for name, cfg in configs.items()}
 
 
-def test_size_tests_find_d_eff_rising_with_n_only_with_knollenorgans():
-    rng = np.random.default_rng(0)
+def test_group_size_and_knollenorgans_come_from_the_recorded_configs_not_the_names():
+    configs = groupsize_configs(n2_K="pairs", n4_noK="quartet_deaf")
+    parts = groupsize_parts(pd.DataFrame({"condition": ["pairs", "quartet_deaf", "n1_K", "unrecorded"]}), configs)
+    assert parts["condition"].tolist() == ["pairs", "quartet_deaf", "n1_K"]  # a condition not recorded is dropped
+    assert parts["n_agents"].tolist() == [2, 4, 1] and parts["knollenorgans"].tolist() == ["K", "noK", "K"]
+    named_wrong = groupsize_parts(pd.DataFrame({"condition": ["n3_K"]}), groupsize_configs(n3_K="x", n1_K="n3_K"))
+    assert named_wrong["n_agents"].tolist() == [1]  # the name says 3: the config says 1
+
+
+def planted_dims(slope_k: float, rng) -> pd.DataFrame:
+    """D_eff per agent-episode that rises by ``slope_k`` per agent with Knollenorgans on and is flat without."""
     rows = []
-    for n in (1, 2, 4, 8):
-        rows += [{"condition": f"n{n}_K", "episode": e, "agent": 0, "d_eff": n + rng.normal(0, 0.1)} for e in range(6)]
+    for n in (1, 2, 3, 4):
+        rows += [{"condition": f"n{n}_K", "episode": e, "agent": 0, "d_eff": 3 + slope_k * n + rng.normal(0, 0.1)}
+                 for e in range(6)]
         rows += [{"condition": f"n{n}_noK", "episode": e, "agent": 0, "d_eff": rng.normal(3, 1)} for e in range(6)]
-    dims = pd.DataFrame(rows)
-    table = size_tests(dims)
+    return pd.DataFrame(rows)
+
+
+@pytest.mark.parametrize("slope", [1.0, -1.0, 0.0])
+def test_size_tests_follow_a_planted_slope_of_d_eff_on_n_with_knollenorgans(slope):
+    rng = np.random.default_rng(0)
+    dims = planted_dims(slope, rng)
+    table = size_tests(dims, groupsize_configs())
     assert list(table.columns[: len(STAT_COLUMNS)]) == STAT_COLUMNS and set(table["measure"]) == {"d_eff"}
     tests = table.set_index("group")
     k = dims[dims["condition"].str.endswith("_K")]
     expected = sps.spearmanr(k["condition"].str.extract(r"n(\d+)")[0].astype(int), k["d_eff"])
     assert tests.loc["K", "effect"] == pytest.approx(expected.statistic)
-    assert tests.loc["K", "p"] == pytest.approx(expected.pvalue) and tests.loc["K", "p"] < 1e-4
+    assert tests.loc["K", "p"] == pytest.approx(expected.pvalue)
+    if slope:
+        assert np.sign(tests.loc["K", "effect"]) == np.sign(slope) and tests.loc["K", "p"] < 1e-4
+    else:
+        assert tests.loc["K", "p"] > 0.01
     assert tests.loc["noK", "p"] > 0.01 and tests.loc["K", "control"] == "n_agents" and tests.loc["K", "n"] == 24
-    other = size_tests(pd.DataFrame({"condition": ["control"], "d_eff": [2.0]}))
-    assert len(other) == 1 and np.isnan(other["p"].item()) and "groupsize" in other["reason"].item()
+
+
+def test_an_assay_of_one_group_size_gets_one_row_that_says_so():
+    one = {"control": groupsize_configs()["n4_K"], "deaf": groupsize_configs()["n4_noK"]}
+    other = size_tests(pd.DataFrame({"condition": ["control", "deaf"], "d_eff": [2.0, 3.0]}), one)
+    assert len(other) == 1 and np.isnan(other["p"].item())
+    assert "does not vary across the conditions: [4]" in other["reason"].item()
 
 
 def pair(episodes: int = 8, steps: int = 120, loud_far: float = 3.0):

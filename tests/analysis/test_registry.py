@@ -42,7 +42,8 @@ ASSAY_SPECIFIC = {("onepatch", "role_tests"): ("A_gt_B", "A_alone_75", "B_alone_
                   ("onepatch", "reach_tests"): ("bot0.5_B0.5_rate0_frozen", "bot0.5_B0.5_rate1_moving"),
                   ("dynamics", "size_tests"): ("n2_K", "n4_K", "n2_noK", "n4_noK")}
 #: The assay whose recorded conditions (conditions.parquet) say who is who in those tests.
-RECORDED = {("onepatch", "role_tests"): "onepatch", ("onepatch", "reach_tests"): "bot"}
+RECORDED = {("onepatch", "role_tests"): "onepatch", ("onepatch", "reach_tests"): "bot",
+            ("dynamics", "size_tests"): "groupsize"}
 
 
 def settings_for(name: str):

@@ -336,11 +336,14 @@ def c16(flip):
             A("interactions", "square2", "bite_rate_episodes"): rates}
 
 
+KNOLLENORGAN_OFF = "sensors.knollenorgan.enabled=false"
+
+
 def c17(flip):
     rng = np.random.default_rng(17)
     width = CFG.train.hidden
     patchy = pd.DataFrame({"condition": "control", "episode": np.arange(20) // 2, "agent": np.arange(20) % 2,
-                           "d_eff": (0.8 if flip else 0.1) * width + rng.normal(0, 0.5, 20)})
+                           "n_units": width, "d_eff": (0.8 if flip else 0.1) * width + rng.normal(0, 0.5, 20)})
     flat = rng.normal(10, 1, 10)
     rows = []
     for n in range(1, 5):
@@ -349,8 +352,12 @@ def c17(flip):
         rows += [pd.DataFrame({"condition": f"n{n}_K", "episode": np.arange(10), "agent": 0, "d_eff": k}),
                  pd.DataFrame({"condition": f"n{n}_noK", "episode": np.arange(10), "agent": 0, "d_eff": no_k})]
     groupsize = pd.concat(rows, ignore_index=True)
+    # the conditions' N and Knollenorgan state as the run recorded them (the names only label them)
+    conditions = recorded_table({f"n{n}_{k}": [f"env.n_agents={n}", *([] if k == "K" else [KNOLLENORGAN_OFF])]
+                                 for n in range(1, 5) for k in ("K", "noK")})
     return {A("dynamics", "patchy4", "dimensionality"): patchy, A("dynamics", "groupsize", "dimensionality"): groupsize,
-            A("dynamics", "groupsize", "size_tests"): size_tests(groupsize)}
+            A("dynamics", "groupsize", "size_tests"): size_tests(groupsize, recorded_conditions(conditions)),
+            R("groupsize", "conditions"): conditions}
 
 
 def hidden_of(steps: pd.DataFrame, columns: dict[str, np.ndarray], units: int = 6, seed: int = 0) -> pd.DataFrame:

@@ -107,19 +107,20 @@ def test_power_by_size_puts_each_agent_in_its_size_class_and_drops_equal_sizes()
     assert sorted(by_x[0]) == [1.0, 3.0] and sorted(by_x[1]) == [2.0, 4.0]
 
 
-def test_group_size_and_knollenorgans_come_from_the_condition_names():
-    frame = fig6.groupsize_frame(pd.DataFrame({"condition": ["n1_K", "n3_noK", "other"], "d_eff": [1.0, 2.0, 3.0]}))
-    assert frame["n_agents"].tolist() == [1, 3]
+def test_group_size_and_knollenorgans_come_from_the_recorded_conditions(recorded):
+    frame = fig6.groupsize_frame(pd.DataFrame({"condition": ["n1_K", "n3_noK", "other"], "d_eff": [1.0, 2.0, 3.0]}),
+                                 recorded("groupsize"))
+    assert frame["n_agents"].tolist() == [1, 3]  # "other" is no condition the run recorded
     assert frame["knollenorgans"].tolist() == ["K on", "K off"]
-    with pytest.raises(ValueError, match="n<N>_K or n<N>_noK"):
-        fig6.groupsize_frame(pd.DataFrame({"condition": ["control"]}))
+    with pytest.raises(ValueError, match="no conditions/groupsize"):
+        fig6.groupsize_frame(pd.DataFrame({"condition": ["n1_K"]}), {})
 
 
-def test_deff_vs_group_size_means_per_knollenorgan_state():
+def test_deff_vs_group_size_means_per_knollenorgan_state(recorded):
     dims = pd.DataFrame({"condition": ["n1_K", "n1_K", "n2_K", "n1_noK", "n2_noK"], "d_eff": [2.0, 4.0, 5.0, 1.0, 1.5],
                          "reason": ""})
     tests = pd.DataFrame({"group": ["K", "noK"], "effect": [0.5, np.nan], "stars": ["XK", "n/a"]})
-    ax = draw("fig6/B", {"dims": dims, "tests": tests})
+    ax = draw("fig6/B", {"dims": dims, "tests": tests, **recorded("groupsize")})
     assert texts(ax)[-1] == "K on: rho +0.50 XK\nK off: n/a"
     means = {c.get_label(): c.lines[0].get_ydata() for c in ax.containers}
     np.testing.assert_allclose(means["K on"], [3.0, 5.0])

@@ -150,18 +150,19 @@ def wideband_power(h: np.ndarray, window: int = DEFAULTS.spectrogram_window,
 def dynamics_table(hidden: pd.DataFrame, fraction: float = DEFAULTS.variance_fraction,
                    window: int = DEFAULTS.spectrogram_window, overlap: int = DEFAULTS.spectrogram_overlap,
                    *, fps: PerCondition) -> pd.DataFrame:
-    """Per agent-episode of a hidden table: D_eff, PCs for ``fraction`` of the variance, wideband power (at its
-    condition's ``fps``), reason."""
+    """Per agent-episode of a hidden table: its hidden units (``n_units``: the width of the policy that acted, so a
+    reader needs no config to put D_eff in proportion), D_eff, PCs for ``fraction`` of the variance, wideband power
+    (at its condition's ``fps``), reason."""
     require(hidden, [*AGENT_EPISODE, "t"], "hidden table")
     rows = []
     for keys, sub in hidden.groupby(AGENT_EPISODE, sort=True):
         h = hidden_matrix(sub)
-        rows.append({**dict(zip(AGENT_EPISODE, keys, strict=True)), "n_steps": len(h),
+        rows.append({**dict(zip(AGENT_EPISODE, keys, strict=True)), "n_steps": len(h), "n_units": h.shape[1],
                      "d_eff": effective_dimensionality(h), "pcs_for_variance": pcs_for_variance(h, fraction),
                      "wideband_power": wideband_power(h, window, overlap, fs=value_of(fps, keys[0])),
                      "reason": degenerate_reason(h)})
-    return pd.DataFrame(rows, columns=[*AGENT_EPISODE, "n_steps", "d_eff", "pcs_for_variance", "wideband_power",
-                                       "reason"])
+    return pd.DataFrame(rows, columns=[*AGENT_EPISODE, "n_steps", "n_units", "d_eff", "pcs_for_variance",
+                                       "wideband_power", "reason"])
 
 
 def _zscore(h: np.ndarray) -> np.ndarray:

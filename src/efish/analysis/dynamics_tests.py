@@ -3,9 +3,10 @@ size, wideband power by context.
 
 The dynamics analysis writes them as statistic tables (columns of
 :data:`efish.analysis.stats.STAT_COLUMNS` plus ``measure``): ``size_tests``
-(Spearman of D_eff against the group size N of ``config/assay/groupsize.yaml``,
-whose conditions are named ``n<N>_K`` / ``n<N>_noK``, separately with
-Knollenorgans on and off) and ``power_tests`` (wideband power with the nearest
+(Spearman of D_eff against the group size N, separately with Knollenorgans on
+and off, each condition's N and Knollenorgan state read from the config the
+run recorded for it, whatever the condition is called: the groupsize assay,
+``config/assay/groupsize.yaml``, or a user's assay that varies ``env.n_agents``) and ``power_tests`` (wideband power with the nearest
 conspecific near vs far, Wilcoxon over agent-episodes; of the smallest agent of
 an episode vs the others, Mann-Whitney). Fig 6 and the claims C17 and C21 read
 these rows.
@@ -13,38 +14,53 @@ these rows.
 
 from __future__ import annotations
 
-import re
+from collections.abc import Mapping
 
 import numpy as np
 import pandas as pd
 
+from ..config.schema import EfishConfig
 from ._tables import AGENT_EPISODE, EPISODE, PerCondition, agent_sizes, nan_frame, require, value_of
 from .dynamics import _with_steps, degenerate_reason, units, wideband_power
 from .stats import mann_whitney, nan_stat_row, spearman, wilcoxon_paired
 
-#: A groupsize condition: group size N and Knollenorgans on (``K``) or off (``noK``).
-GROUPSIZE_CONDITION = re.compile(r"^n(\d+)_(K|noK)$")
 NEAR_FAR_COLUMNS = [*AGENT_EPISODE, "where", "n_steps", "wideband_power", "reason"]
+#: A Knollenorgan state's group label in the tables: on (``K``) or off (``noK``).
+KNOLLENORGAN_GROUPS = {True: "K", False: "noK"}
 
 
-def groupsize_parts(table: pd.DataFrame) -> pd.DataFrame:
-    """The rows of groupsize conditions with ``n_agents`` (N) and ``knollenorgans`` (``K`` or ``noK``)."""
+def group_settings(conditions: Mapping[str, EfishConfig]) -> pd.DataFrame:
+    """Each recorded condition's group size ``n_agents`` (``env.n_agents``) and ``knollenorgans`` (``K`` when
+    ``sensors.knollenorgan.enabled``, else ``noK``), as the run simulated it
+    (:func:`efish.config.recorded.recorded_conditions`)."""
+    return pd.DataFrame({"condition": list(conditions),
+                         "n_agents": [int(c.env.n_agents) for c in conditions.values()],
+                         "knollenorgans": [KNOLLENORGAN_GROUPS[bool(c.sensors.knollenorgan.enabled)]
+                                           for c in conditions.values()]})
+
+
+def groupsize_parts(table: pd.DataFrame, conditions: Mapping[str, EfishConfig]) -> pd.DataFrame:
+    """The rows of ``table`` with their condition's ``n_agents`` (N) and ``knollenorgans`` (``K`` or ``noK``) from
+    :func:`group_settings`, in the table's order; rows of a condition the run did not record are dropped."""
     require(table, ["condition"], "table")
-    parts = table["condition"].astype(str).str.extract(GROUPSIZE_CONDITION)
-    keep = parts[0].notna().to_numpy()
-    return table[keep].assign(n_agents=pd.to_numeric(parts[0][keep]).astype(int), knollenorgans=parts[1][keep])
+    settings = group_settings(conditions)
+    clash = [c for c in ("n_agents", "knollenorgans") if c in table.columns]
+    return table.drop(columns=clash).merge(settings, on="condition", how="inner", validate="many_to_one")
 
 
-def size_tests(dims: pd.DataFrame) -> pd.DataFrame:
+def size_tests(dims: pd.DataFrame, conditions: Mapping[str, EfishConfig]) -> pd.DataFrame:
     """Spearman rho of D_eff against group size N over agent-episodes, one row per Knollenorgan state (group K, noK).
 
-    ``dims``: the dimensionality table (:func:`efish.analysis.dynamics.dynamics_table`).
-    An assay without groupsize conditions gets one NaN row that says so.
+    ``dims``: the dimensionality table (:func:`efish.analysis.dynamics.dynamics_table`); ``conditions``: the assay's
+    recorded conditions, which give each condition's N and Knollenorgan state. An assay whose conditions all have
+    one group size gets one NaN row that says so.
     """
     require(dims, ["condition", "d_eff"], "dimensionality table")
-    frame = groupsize_parts(dims)
-    if frame.empty:
-        return nan_stat_row("no groupsize condition (n<N>_K or n<N>_noK)", measure="d_eff")
+    frame = groupsize_parts(dims, conditions)
+    if frame["n_agents"].nunique() < 2:
+        sizes = sorted(frame["n_agents"].unique().tolist())
+        return nan_stat_row(f"the group size (env.n_agents) does not vary across the conditions: {sizes}",
+                            measure="d_eff")
     return spearman(frame, "n_agents", "d_eff", by="knollenorgans").assign(measure="d_eff")
 
 

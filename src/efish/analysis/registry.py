@@ -291,7 +291,7 @@ def _dynamics(t: Tables, a: AnalysisConfig, conditions: Conditions) -> Tables:
             "plsc_collapse": plsc_collapse_table(hidden, steps, (0, 1), a.plsc_edges_cm, a.plsc_null_draws,
                                                  a.claims_alpha, swaps=a.plsc_label_swaps, rng=rng),
             "condition_tests": dunnett_by_measure(dims, DYNAMICS_MEASURES, "condition", control, a.seed),
-            "size_tests": size_tests(dims), **_power(hidden, steps, dims, a, fps)}
+            "size_tests": size_tests(dims, conditions), **_power(hidden, steps, dims, a, fps)}
 
 
 def _power(hidden: pd.DataFrame, steps: pd.DataFrame, dims: pd.DataFrame, a: AnalysisConfig,

@@ -16,7 +16,7 @@ import pandas as pd
 from ..analysis._tables import AGENT_EPISODE
 from ..analysis.decoding import FOOD_TARGETS, SENSED_TARGETS
 from ..analysis.dynamics_tests import groupsize_parts
-from ..layout import analysis_table
+from ..layout import analysis_table, assay_table
 from .context import Context, claim
 from .fig2 import HOMING_ELECTRIC
 from .intervals import smallest_p_signed_rank
@@ -26,18 +26,21 @@ from .verdicts import Outcome, Part
 
 
 @claim("C17", "6A-C", "hidden dynamics are low-dimensional; D_eff grows with group size only with Knollenorgans",
-       [analysis_table("dynamics", a, "dimensionality") for a in ("patchy4", "groupsize")])
+       [*(analysis_table("dynamics", a, "dimensionality") for a in ("patchy4", "groupsize")),
+        assay_table("groupsize", "conditions")])
 def c17(ctx: Context) -> list[Part]:
-    a, width = ctx.cfg.analysis, ctx.cfg.train.hidden
+    a = ctx.cfg.analysis
 
     def low() -> Outcome:
+        # D_eff as a share of the acting policy's own width (the table's n_units), not of this config's train.hidden
         dims = ctx.table(analysis_table("dynamics", "patchy4", "dimensionality"))
-        dims = dims.assign(fraction=dims["d_eff"] / width).dropna(subset=["fraction"])
+        dims = dims.assign(fraction=dims["d_eff"] / dims["n_units"]).dropna(subset=["fraction"])
         return one_sample_part(ctx, per_episode(dims, "fraction"), "fraction", a.claims_deff_fraction, -1)
 
     def groupsize_episodes() -> pd.DataFrame:
         """D_eff averaged over the agents of each groupsize episode (the episode is the unit)."""
-        dims = groupsize_parts(ctx.table(analysis_table("dynamics", "groupsize", "dimensionality")))
+        dims = groupsize_parts(ctx.table(analysis_table("dynamics", "groupsize", "dimensionality")),
+                               ctx.recorded("groupsize"))
         return (dims.groupby(["condition", "episode", "n_agents", "knollenorgans"], as_index=False)["d_eff"].mean()
                 .dropna(subset=["d_eff"]))
 
@@ -49,8 +52,8 @@ def c17(ctx: Context) -> list[Part]:
         on = (d["knollenorgans"] == "K").to_numpy(np.float64)
         b, p, n, ci = interaction_slope(d["n_agents"], d["d_eff"], on, 1 - ctx.level())
         return Outcome(b, p, n, +1, ci, ci_method=f"inverts the t-test, level {ctx.level():.3g}")
-    return [ctx.part("low-dimensional", f"Hodges-Lehmann estimate over episodes of the agents' mean D_eff / width ({width}) "
-                     f"minus {a.claims_deff_fraction} (patchy4); Wilcoxon", low),
+    return [ctx.part("low-dimensional", "Hodges-Lehmann estimate over episodes of the agents' mean D_eff / hidden units "
+                     f"(n_units) minus {a.claims_deff_fraction} (patchy4); Wilcoxon", low),
             ctx.part("D_eff grows with N, K on", "Spearman rho(mean D_eff of the episode, N), Knollenorgans on "
                      "(groupsize)", grows),
             ctx.part("growth larger with K than without", "OLS slope of episode D_eff on N with Knollenorgans on "

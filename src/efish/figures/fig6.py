@@ -15,8 +15,6 @@ is missing.
 
 from __future__ import annotations
 
-import re
-
 import numpy as np
 import pandas as pd
 
@@ -29,6 +27,7 @@ from .style import (
     RECEPTOR_COLOURS,
     analysis_settings,
     annotate_stars,
+    assay_conditions,
     box_strip,
     condition_order,
     condition_palette,
@@ -40,8 +39,7 @@ from .style import (
     stars_for,
 )
 
-#: The groupsize assay's condition names: ``n<N>_K`` (Knollenorgans on) and ``n<N>_noK`` (off).
-GROUPSIZE_CONDITION = re.compile(r"^n(\d+)_(K|noK)$")
+#: The dynamics analysis's Knollenorgan groups (efish.analysis.dynamics_tests.KNOLLENORGAN_GROUPS) as drawn.
 KNOLLENORGAN_STATE = {"K": "K on", "noK": "K off"}
 KNOLLENORGAN_COLOURS = {"K on": RECEPTOR_COLOURS["knollenorgan"], "K off": NEUTRAL_COLOUR}
 KNOLLENORGAN_STYLES = {"K on": "-", "K off": "--"}
@@ -88,19 +86,19 @@ def dimensionality_box(tables: Tables, ax) -> None:
         ax.set_title("Hidden-state dimensionality")
 
 
-def groupsize_frame(table: pd.DataFrame) -> pd.DataFrame:
-    """A groupsize table with ``n_agents`` and ``knollenorgans`` (K on / K off) parsed from the condition."""
-    parts = table["condition"].astype(str).str.extract(GROUPSIZE_CONDITION)
-    if parts.isna().all(axis=None):
-        raise ValueError(f"no groupsize condition is named n<N>_K or n<N>_noK: "
-                         f"{sorted(table['condition'].dropna().unique())}")
-    return table.assign(n_agents=pd.to_numeric(parts[0]), knollenorgans=parts[1].map(KNOLLENORGAN_STATE)) \
-        .dropna(subset=["knollenorgans"])
+def groupsize_frame(table: pd.DataFrame, tables: Tables) -> pd.DataFrame:
+    """A groupsize table with ``n_agents`` and ``knollenorgans`` (K on / K off) from the config each condition
+    recorded (the panel's conditions/groupsize table), whatever the conditions are called."""
+    # imported here: the workflow imports every figure module to list the panels, and this one pulls in sklearn
+    from ..analysis.dynamics_tests import groupsize_parts
+
+    frame = groupsize_parts(table, assay_conditions(tables, "groupsize"))
+    return frame.assign(knollenorgans=frame["knollenorgans"].map(KNOLLENORGAN_STATE))
 
 
 def deff_vs_group_size(tables: Tables, ax) -> None:
     """Panel B: D_eff per agent-episode against group size, Knollenorgans on and off (mean +- SEM)."""
-    frame = groupsize_frame(tables["dims"])
+    frame = groupsize_frame(tables["dims"], tables)
     if mean_lines(ax, frame, "n_agents", "d_eff", "knollenorgans", KNOLLENORGAN_COLOURS, KNOLLENORGAN_STYLES):
         # the dynamics analysis's Spearman of D_eff against N per Knollenorgan state (size_tests; group K / noK)
         tests = tables["tests"]
@@ -118,7 +116,7 @@ def deff_vs_group_size(tables: Tables, ax) -> None:
 
 def subsampling_curves(tables: Tables, ax) -> None:
     """Panel C: mean D_eff of random unit subsets against the fraction of units kept, per group size and K."""
-    frame = groupsize_frame(tables["subsampling"]).dropna(subset=["d_eff"])
+    frame = groupsize_frame(tables["subsampling"], tables).dropna(subset=["d_eff"])
     if frame.empty:
         missing(ax, "no finite D_eff in the groupsize subsampling table")
         return
